@@ -1,0 +1,49 @@
+/* Solid walls and periodic boundaries as ghost particles (paper 002 Sec. IV A:
+ * "mirrored ghost particles", Refs. 17 and 42). Engine side only: where the ghosts
+ * are and how vectors map into them. Which values they carry (pressure with the
+ * hydrostatic correction, mirrored gradients) is the scheme's business.
+ *
+ * A ghost g of fluid particle s: x_g = J x_s + c, velocity u_g = T u_s, and the
+ * displacement e_g = x_g - x_s of its wall mirror (zero for pure periodic images). */
+#ifndef RHOD_BOUNDARY_H
+#define RHOD_BOUNDARY_H
+
+#include "rhod/config.h"
+#include "rhod/particles.h"
+#include "rhod/scene.h"
+
+#define RHOD_SEG_STRIDE 8  /* ax, ay, nx, ny, tx, ty, length, noslip */
+#define RHOD_CIRC_STRIDE 5 /* cx, cy, radius, side (+1 fluid inside, -1 outside), noslip */
+#define RHOD_MAX_GHOSTS_PER_PARTICLE 6
+
+typedef struct {
+  int nseg, ncorner, ncirc;
+  real *seg;        /* nseg * RHOD_SEG_STRIDE; n is the normal pointing into the fluid */
+  int32_t *corner;  /* ncorner * 2: segments meeting at a corner that needs a double mirror */
+  real *circ;       /* ncirc * RHOD_CIRC_STRIDE */
+  int periodic[2];
+  double lo[2], hi[2]; /* domain box */
+  int32_t *count;      /* per-particle ghost counts (scan buffer), cap + 1 */
+  size_t count_cap;
+} rhod_boundary;
+
+/* Builds the wall segments, corners and circles of a scene, and the domain box. */
+int rhod_boundary_init(rhod_boundary *b, const rhod_scene *s, const double lo[2],
+                       const double hi[2]);
+void rhod_boundary_free(rhod_boundary *b);
+
+/* Regenerates every ghost for the fluid at [0, p->n): wall mirrors of fluid particles
+ * within `radius_ratio * dx_i` of a wall, then periodic images of fluid and wall
+ * ghosts that fall within `margin` of the box. Grows the store if needed.
+ * Copies x, y, m, dx into the ghosts and sets gsrc, gJ, gT, ge. */
+int rhod_ghosts_build(rhod_boundary *b, rhod_particles *p, real radius_ratio, real margin);
+
+/* Reflects fluid particles that ended a step just behind a wall (see ghosts.c);
+ * returns how many. */
+long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p);
+
+/* Signed distance from a point to the nearest wall (positive on the fluid side);
+ * +HUGE_VAL when there are no walls. Host side, for setup. */
+double rhod_wall_distance(const rhod_boundary *b, double x, double y);
+
+#endif

@@ -1,0 +1,41 @@
+/* Build-wide choices: floating-point precision and the loop pragmas that make one
+ * loop text compile for the CPU (OpenMP threads) and for NVIDIA GPUs (GCC nvptx
+ * offload). See ../shared/design/offload.md for why each flag is there. */
+#ifndef RHOD_CONFIG_H
+#define RHOD_CONFIG_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef RHOD_SINGLE
+typedef float real;
+#define RHOD_REAL_NAME "single"
+#else
+typedef double real;
+#define RHOD_REAL_NAME "double"
+#endif
+
+/* Dimension of the particle data. The scheme is written for 2D (paper 002, Sec. VI is
+ * 2D throughout); 3D is a later step. */
+#define RHOD_DIM 2
+
+/* RHOD_KERNEL_LOOP opens a loop over particles that runs on the device when the build
+ * offloads (arrays must be present there: rhod_device_* in device.h), on the host
+ * threads otherwise. `simd` is needed on nvptx, or only one lane in 32 works. */
+#ifdef RHOD_OFFLOAD
+#define RHOD_PRAGMA(x) _Pragma(#x)
+#define RHOD_KERNEL_LOOP RHOD_PRAGMA(omp target teams distribute parallel for simd)
+#define RHOD_KERNEL_LOOP_REDUCE(op, var)                                                  \
+  RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : var))
+#define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                              \
+  RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : v1, v2))
+#else
+#define RHOD_PRAGMA(x) _Pragma(#x)
+#define RHOD_KERNEL_LOOP RHOD_PRAGMA(omp parallel for schedule(static))
+#define RHOD_KERNEL_LOOP_REDUCE(op, var)                                                  \
+  RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : var))
+#define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                              \
+  RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : v1, v2))
+#endif
+
+#endif

@@ -1,0 +1,79 @@
+/* Writers: HDF5 snapshots (SWIFT-like layout), the XDMF sidecar, PNG pictures,
+ * probes CSV and summary JSON. Every file is written under a temporary name and
+ * renamed, so a crash never leaves a truncated file. Library code: errors are returned
+ * (an rhod_status) with a one-line message in err, never printed or exited on. */
+#ifndef RHOD_IO_H
+#define RHOD_IO_H
+
+#include "rhod/config.h"
+#include "rhod/scene.h"
+#include <stdint.h>
+#include <stdio.h>
+
+/* Host copies of the fluid particle fields for one output time. */
+typedef struct {
+  double time;
+  size_t n;
+  const real *x, *y;      /* positions [m] */
+  const real *ux, *uy;    /* velocities [m/s] */
+  const real *rho;        /* density [kg/m^3] */
+  const real *p;          /* pressure [Pa] */
+  const real *m;          /* mass [kg/m] */
+  const real *size;       /* particle size dx_i [m] */
+  const uint64_t *id;     /* persistent particle id */
+  const uint8_t *fs;      /* free-surface flag (1: in F), may be NULL */
+} rhod_snapshot_view;
+
+/* OUT/snapshot_NNNN.h5: /Header attrs Time, Dimension (2), NumPart; /PartType0 datasets
+ * Coordinates, Velocities (N x 3, z = 0), Densities, Pressures, Masses, ParticleSizes,
+ * ParticleIDs, FreeSurface (if fs); /Parameters string attributes (dotted keys). Plain
+ * contiguous datasets, no filters. Stored as double whatever the build precision. */
+int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
+                        const rhod_param_list *params, char *err, size_t errlen);
+
+/* Reads a snapshot written by rhod_write_snapshot (arrays malloc'd, double). */
+typedef struct {
+  double time;
+  size_t n;
+  double *x, *y, *ux, *uy, *rho, *p, *m, *size;
+  uint64_t *id;
+  uint8_t *fs;             /* FreeSurface, NULL when the file has none */
+  rhod_param_list params;  /* /Parameters in file order; owned here, freed by
+                              rhod_snapshot_data_free (not rhod_param_list_free) */
+} rhod_snapshot_data;
+int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen);
+void rhod_snapshot_data_free(rhod_snapshot_data *d);
+
+/* OUT/snapshots.xdmf: a temporal collection of every snapshot written so far, as a
+ * Polyvertex grid that ParaView opens as a time series. Rewritten (atomically) after
+ * each snapshot. */
+int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
+                    char *err, size_t errlen);
+
+/* A PNG picture of one field: each particle a disc of its own size, coloured by a
+ * perceptual colour map; the frame is the box [lo, hi]; a colour bar with its range
+ * and the time are drawn. range NULL: auto (min/max of the field). */
+int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
+                       unsigned width, const double lo[2], const double hi[2],
+                       const double *range, char *err, size_t errlen);
+
+/* probes.csv: a header row (first column t) then one row per sample. The file is kept
+ * open and flushed after every row. */
+typedef struct {
+  FILE *f;
+  char *path;
+  unsigned ncols;
+} rhod_csv;
+int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *const *names,
+                  char *err, size_t errlen);
+int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen);
+int rhod_csv_close(rhod_csv *c, char *err, size_t errlen);
+
+/* Writes `text` to path through path.tmp + rename. */
+int rhod_write_file_atomic(const char *path, const char *text, char *err, size_t errlen);
+/* The same for `len` bytes of any data: path.tmp in the same folder is written, fsync'd,
+ * closed and renamed onto path; on failure it is removed and path is left untouched. */
+int rhod_write_bytes_atomic(const char *path, const void *data, size_t len, char *err,
+                            size_t errlen);
+
+#endif

@@ -1,0 +1,62 @@
+/* Particle store: structure of arrays with spare capacity, device-resident between
+ * steps when the build offloads. The engine knows no physics: a scheme registers the
+ * arrays it needs (rhod_particles_add_field) and the store allocates, maps, grows and
+ * reorders them all alike.
+ *
+ * Layout: fluid particles at [0, n), ghost particles (mirrors and periodic images,
+ * rebuilt every RK stage) at [n, n + ng). */
+#ifndef RHOD_PARTICLES_H
+#define RHOD_PARTICLES_H
+
+#include "rhod/config.h"
+#include <stdint.h>
+
+#define RHOD_MAX_FIELDS 96
+
+typedef struct {
+  const char *name;
+  void **ptr;       /* address of the owner's pointer variable */
+  size_t elem;      /* bytes per particle */
+  int persistent;   /* 1: carried across steps and reordered with the particles */
+} rhod_field_desc;
+
+typedef struct {
+  size_t n;    /* fluid particles */
+  size_t ng;   /* ghosts after the fluid */
+  size_t cap;  /* allocated particles (fluid + ghosts) */
+  /* persistent state */
+  real *x, *y, *ux, *uy, *rho, *m, *dx;
+  uint64_t *id;
+  /* ghost description, valid at [n, n + ng): source fluid particle, position
+   * Jacobian J (x' = J x + c, row-major), velocity transform T, and the
+   * displacement e used for the hydrostatic correction P' = P + rho g.e */
+  int32_t *gsrc;
+  real *gJ, *gT; /* 4 per particle */
+  real *ge;      /* 2 per particle */
+  /* scratch for reordering */
+  void *scratch;
+  size_t scratch_elem;
+  int32_t *perm;
+  rhod_field_desc fields[RHOD_MAX_FIELDS];
+  int nfields;
+  uint64_t next_id;
+} rhod_particles;
+
+int rhod_particles_init(rhod_particles *p, size_t cap);
+/* Registers an array of `elem` bytes per particle; allocated (and mapped) at once. */
+int rhod_particles_add_field(rhod_particles *p, const char *name, void **ptr, size_t elem,
+                             int persistent);
+/* Grows every array to at least `cap` (keeps content of persistent ones). */
+int rhod_particles_reserve(rhod_particles *p, size_t cap);
+void rhod_particles_free(rhod_particles *p);
+/* Reorders the persistent arrays of the fluid: new[k] = old[perm[k]], k < n.
+ * perm lives on the device (p->perm). */
+void rhod_particles_permute(rhod_particles *p);
+/* Copies fields between host and device (no-ops without offload). count = particles. */
+void rhod_to_host(void *ptr, size_t bytes);
+void rhod_to_device(void *ptr, size_t bytes);
+/* Where the kernels run: fills `buf` with e.g. "host (2 threads)" or
+ * "GPU device 0 of 1 (offload)"; returns 1 when on a device. */
+int rhod_where(char *buf, size_t len);
+
+#endif

@@ -1,0 +1,56 @@
+/* A simulation: the engine (particles, ghosts, cells, integrator) driving the RHOD-SPH
+ * scheme for one scene. Library code: returns rhod_status codes with a message. */
+#ifndef RHOD_SIM_H
+#define RHOD_SIM_H
+
+#include "rhod/boundary.h"
+#include "rhod/cells.h"
+#include "rhod/integrator.h"
+#include "rhod/particles.h"
+#include "rhod/scene.h"
+#include "rhod/sph.h"
+
+typedef struct {
+  const rhod_scene *sc;
+  rhod_particles p;
+  rhod_boundary bnd;
+  rhod_cells cells;
+  rhod_sph sph;
+  rhod_rk4 rk;
+  double lo[2], hi[2]; /* domain box */
+  double margin;       /* ghost layer width: largest kernel radius */
+  double t, dt;
+  long step;
+  long reflected; /* particles put back by the wall-crossing guard, whole run */
+  int neighbours_fresh; /* ghosts and cells match the current state */
+} rhod_sim;
+
+/* Fills the fluid from the scene (square lattice of spacing dx, initial pressure) and
+ * sets everything up on the device. */
+int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen);
+void rhod_sim_free(rhod_sim *s);
+
+/* Makes ghosts and cells match the current state (sorting the fluid by cell first when
+ * sort != 0). After it, probes and outputs see consistent ghost values. */
+int rhod_sim_prepare(rhod_sim *s, int sort);
+
+/* One RK4 step of size s->dt (clipped by the caller). Then checks the new state:
+ * RHOD_ERR_UNSTABLE with the particle and the cause in err when it is not finite or a
+ * particle left the domain; the state is then left as computed (not written out). */
+int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen);
+
+/* Probe columns: names and values at the current (prepared) state. */
+unsigned rhod_probe_columns(const rhod_scene *sc, const char **names, unsigned max);
+void rhod_probe_values(rhod_sim *s, double *values);
+
+/* Host copies of the fluid for output (arrays owned by the caller's buffers). */
+typedef struct {
+  real *x, *y, *ux, *uy, *rho, *p, *m, *dx;
+  uint64_t *id;
+  uint8_t *fs;
+  size_t cap;
+} rhod_host_copy;
+int rhod_sim_fetch(rhod_sim *s, rhod_host_copy *h);
+void rhod_host_copy_free(rhod_host_copy *h);
+
+#endif

@@ -1,0 +1,50 @@
+/* The RHOD-SPH scheme of paper 002 (Michel et al. 2025), Secs. III-IV, as a set of
+ * passes over the engine's particles. ../shared/design/scheme.md gives the order. */
+#ifndef RHOD_SPH_H
+#define RHOD_SPH_H
+
+#include "rhod/boundary.h"
+#include "rhod/cells.h"
+#include "rhod/particles.h"
+#include "rhod/scene.h"
+
+typedef struct {
+  /* parameters (from the scene) */
+  int kernel;
+  real ratio;              /* R/dx */
+  real rho0, c0, mu, gx, gy;
+  real cfl, cfl_visc;
+  int riemann, recon, shifting, damper, fsdetect;
+  real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
+  /* per-particle fields (scratch, rebuilt each stage) */
+  real *P, *V;
+  real *gam, *ggam;  /* Shepard Gamma (Eq. 7) and its gradient (Eq. 27), 2 */
+  real *L;           /* renormalisation matrix (Eq. 8), 4, row-major */
+  real *gP, *gu;     /* renormalised gradients (Eq. 14) of P (2) and u (4: dux/dx,
+                        dux/dy, duy/dx, duy/dy) */
+  real *D;           /* velocity divergence (Eq. 5) */
+  real *gC;          /* concentration gradient (Eq. 29), 2 */
+  real *uch;         /* U_char (after Eq. 27) */
+  real *lam;         /* smallest eigenvalue of sym(L^-1) */
+  real *nrm;         /* free-surface normal, 2 */
+  real *nt, *sig;    /* shifting projection normal and weight (Eq. 26), 2 and 1 */
+  real *du;          /* shifting velocity (Eq. 27), 2 */
+  real *drho, *acc, *vel; /* time derivatives: d rho/dt, du/dt (2), dx/dt (2) */
+  uint8_t *fs;       /* 1: free-surface particle (set F) */
+  uint8_t *reg;      /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
+} rhod_sph;
+
+int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p);
+
+/* One right-hand-side evaluation at the current positions: the neighbour structure
+ * must be built (ghosts generated, cells sorted). Fills drho, acc, vel for the fluid. */
+void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, const rhod_cells *c, real dt);
+
+/* Values of the ghosts from their sources (state part: u, P, rho, V), and the fluid
+ * EOS. Called after the ghosts are built and before any gather. */
+void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p);
+
+/* Time step of Eq. 11 over the fluid. */
+real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p);
+
+#endif

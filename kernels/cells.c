@@ -1,0 +1,193 @@
+/* Cell lists: key, histogram, scan, scatter, per-cell order by index. Runs where the
+ * particles live (device or host). */
+#include "rhod/cells.h"
+#include "rhod/scene.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SCAN_BLOCK 2048
+
+static int32_t *scan_blocks;
+static size_t scan_blocks_cap;
+
+static int32_t *blocks_buffer(size_t nb) {
+  if (nb > scan_blocks_cap) {
+    if (scan_blocks) {
+#ifdef RHOD_OFFLOAD
+      int32_t *b = scan_blocks;
+      size_t c = scan_blocks_cap;
+#pragma omp target exit data map(delete : b[0 : c])
+      (void)b; /* GCC 12 flags map-only variables as unused */
+#endif
+      free(scan_blocks);
+    }
+    scan_blocks_cap = nb + 64;
+    scan_blocks = calloc(scan_blocks_cap, sizeof(int32_t));
+    if (!scan_blocks) {
+      scan_blocks_cap = 0;
+      return NULL;
+    }
+#ifdef RHOD_OFFLOAD
+    int32_t *b = scan_blocks;
+    size_t c = scan_blocks_cap;
+#pragma omp target enter data map(alloc : b[0 : c])
+    (void)b; /* GCC 12 flags map-only variables as unused */
+#endif
+  }
+  return scan_blocks;
+}
+
+long rhod_scan_exclusive(int32_t *a, size_t n) {
+  if (n == 0) return 0;
+  const long nb = (long)((n + SCAN_BLOCK - 1) / SCAN_BLOCK);
+  int32_t *bs = blocks_buffer((size_t)nb);
+  if (!bs) return -1;
+  const long nn = (long)n;
+  /* 1. each block's sum */
+  RHOD_KERNEL_LOOP
+  for (long b = 0; b < nb; b++) {
+    long s = 0;
+    const long e = (b + 1) * SCAN_BLOCK < nn ? (b + 1) * SCAN_BLOCK : nn;
+    for (long k = b * SCAN_BLOCK; k < e; k++) s += a[k];
+    bs[b] = (int32_t)s;
+  }
+  /* 2. scan of the block sums (few: one thread) */
+  long total = 0;
+#ifdef RHOD_OFFLOAD
+#pragma omp target map(tofrom : total)
+#endif
+  {
+    long s = 0;
+    for (long b = 0; b < nb; b++) {
+      const long v = bs[b];
+      bs[b] = (int32_t)s;
+      s += v;
+    }
+    total = s;
+  }
+  /* 3. each block scanned from its offset */
+  RHOD_KERNEL_LOOP
+  for (long b = 0; b < nb; b++) {
+    long s = bs[b];
+    const long e = (b + 1) * SCAN_BLOCK < nn ? (b + 1) * SCAN_BLOCK : nn;
+    for (long k = b * SCAN_BLOCK; k < e; k++) {
+      const long v = a[k];
+      a[k] = (int32_t)s;
+      s += v;
+    }
+  }
+  return total;
+}
+
+static void map_alloc(int32_t **p, size_t n) {
+  *p = calloc(n ? n : 1, sizeof(int32_t));
+#ifdef RHOD_OFFLOAD
+  int32_t *q = *p;
+  if (q) {
+#pragma omp target enter data map(to : q[0 : n])
+  (void)q; /* GCC 12 flags map-only variables as unused */
+  }
+#endif
+}
+
+static void map_free(int32_t **p, size_t n) {
+  if (!*p) return;
+#ifdef RHOD_OFFLOAD
+  int32_t *q = *p;
+#pragma omp target exit data map(delete : q[0 : n])
+  (void)q; /* GCC 12 flags map-only variables as unused */
+#else
+  (void)n;
+#endif
+  free(*p);
+  *p = NULL;
+}
+
+int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double cell,
+                    size_t cap) {
+  memset(c, 0, sizeof *c);
+  if (!(cell > 0)) return RHOD_ERR_SCENE;
+  const double w = hi[0] - lo[0], h = hi[1] - lo[1];
+  c->g.nx = (int)floor(w / cell);
+  c->g.ny = (int)floor(h / cell);
+  if (c->g.nx < 1) c->g.nx = 1;
+  if (c->g.ny < 1) c->g.ny = 1;
+  /* cells a little larger than asked so that nx cells tile the box exactly */
+  const double cw = fmax(w / c->g.nx, h / c->g.ny);
+  if ((double)c->g.nx * c->g.ny > 2e9) return RHOD_ERR_MEMORY;
+  c->g.ox = (real)lo[0];
+  c->g.oy = (real)lo[1];
+  c->g.inv = (real)(1.0 / cw);
+  c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
+  map_alloc(&c->start, c->ncells + 1);
+  map_alloc(&c->count, c->ncells + 1);
+  if (!c->start || !c->count) return RHOD_ERR_MEMORY;
+  return rhod_cells_reserve(c, cap);
+}
+
+int rhod_cells_reserve(rhod_cells *c, size_t cap) {
+  if (cap <= c->cap && c->idx) return RHOD_OK;
+  map_free(&c->idx, c->cap);
+  map_free(&c->key, c->cap);
+  c->cap = cap;
+  map_alloc(&c->idx, cap);
+  map_alloc(&c->key, cap);
+  return (c->idx && c->key) ? RHOD_OK : RHOD_ERR_MEMORY;
+}
+
+void rhod_cells_free(rhod_cells *c) {
+  map_free(&c->start, c->ncells + 1);
+  map_free(&c->count, c->ncells + 1);
+  map_free(&c->idx, c->cap);
+  map_free(&c->key, c->cap);
+}
+
+void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count) {
+  const rhod_grid G = c->g;
+  int32_t *key = c->key, *cnt = c->count, *start = c->start, *idx = c->idx;
+  const long n = (long)count, nc = (long)c->ncells;
+
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k <= nc; k++) cnt[k] = 0;
+
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const int cx = rhod_cell_coord(x[i], G.ox, G.inv, G.nx);
+    const int cy = rhod_cell_coord(y[i], G.oy, G.inv, G.ny);
+    const int k = cy * G.nx + cx;
+    key[i] = k;
+#pragma omp atomic update
+    cnt[k] += 1;
+  }
+
+  rhod_scan_exclusive(cnt, (size_t)nc + 1);
+
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k <= nc; k++) start[k] = cnt[k];
+
+  /* scatter; the slot order inside a cell depends on thread timing ... */
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    int slot;
+#pragma omp atomic capture
+    slot = cnt[key[i]]++;
+    idx[slot] = (int32_t)i;
+  }
+
+  /* ... so each cell is then put in index order (insertion sort: cells are small),
+   * which makes every neighbour sum reproducible bit for bit. */
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nc; k++) {
+    const int a = start[k], b = start[k + 1];
+    for (int s = a + 1; s < b; s++) {
+      const int32_t v = idx[s];
+      int t = s - 1;
+      while (t >= a && idx[t] > v) {
+        idx[t + 1] = idx[t];
+        t--;
+      }
+      idx[t + 1] = v;
+    }
+  }
+}

@@ -1,0 +1,519 @@
+/* RHOD-SPH passes (paper 002, Secs. III-IV; order of ../shared/design/scheme.md).
+ * Every pass is a gather: it writes only particle i's own entries. Conventions:
+ * n_ij = (x_j - x_i)/r, grad_i W_ij = -W'(r; R_i) n_ij = F n_ij with F >= 0, and
+ * W taken with the radius of the gathering particle i. */
+#include "rhod/sph.h"
+#include "kernel.h"
+#include "sph_pair.h"
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
+  memset(s, 0, sizeof *s);
+  s->kernel = sc->kernel;
+  s->ratio = (real)sc->radius_ratio;
+  s->rho0 = (real)sc->rho0;
+  s->c0 = (real)sc->c0;
+  s->mu = (real)sc->mu;
+  s->gx = (real)sc->gravity[0];
+  s->gy = (real)sc->gravity[1];
+  s->cfl = (real)sc->cfl;
+  s->cfl_visc = (real)sc->cfl_visc;
+  s->riemann = sc->riemann;
+  s->recon = sc->reconstruction;
+  s->shifting = sc->shifting;
+  s->damper = sc->acoustic_damper;
+  s->fsdetect = sc->free_surface;
+  s->alpha_ad = (real)sc->alpha_ad;
+  s->sa = (real)sc->shift_a;
+  s->sb = (real)sc->shift_b;
+  s->seps = (real)sc->shift_eps;
+  s->lam_lo = (real)sc->fs_lambda_low;
+  s->lam_hi = (real)sc->fs_lambda_high;
+  s->gamma_th = (real)sc->shepard_threshold;
+  s->theta_th = (real)sc->theta_threshold;
+  int st = RHOD_OK;
+#define F(var, k)                                                                         \
+  if (st == RHOD_OK)                                                                      \
+  st = rhod_particles_add_field(p, #var, (void **)&s->var, (k) * sizeof(*s->var), 0)
+  F(P, 1);
+  F(V, 1);
+  F(gam, 1);
+  F(ggam, 2);
+  F(L, 4);
+  F(gP, 2);
+  F(gu, 4);
+  F(D, 1);
+  F(gC, 2);
+  F(uch, 1);
+  F(lam, 1);
+  F(nrm, 2);
+  F(nt, 2);
+  F(sig, 1);
+  F(du, 2);
+  F(drho, 1);
+  F(acc, 2);
+  F(vel, 2);
+  F(fs, 1);
+  F(reg, 1);
+#undef F
+  return st;
+}
+
+void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
+  const long n = (long)p->n, nt = (long)(p->n + p->ng);
+  real *ux = p->ux, *uy = p->uy, *rho = p->rho, *P = s->P, *V = s->V;
+  const real *m = p->m, *gT = p->gT, *ge = p->ge;
+  const int32_t *gsrc = p->gsrc;
+  const real c0 = s->c0, c2 = s->c0 * s->c0, rho0 = s->rho0, gx = s->gx, gy = s->gy;
+  (void)c0;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    P[i] = c2 * (rho[i] - rho0); /* Eq. 2 */
+    V[i] = m[i] / rho[i];
+  }
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++) {
+    const int k = gsrc[g];
+    const real *T = gT + 4 * g;
+    ux[g] = T[0] * ux[k] + T[1] * uy[k];
+    uy[g] = T[2] * ux[k] + T[3] * uy[k];
+    /* hydrostatic correction of the mirrored pressure (scheme.md, Walls) */
+    const real Pk = c2 * (rho[k] - rho0);
+    const real Pg = Pk + rho[k] * (gx * ge[2 * g] + gy * ge[2 * g + 1]);
+    P[g] = Pg;
+    rho[g] = rho0 + Pg / c2;
+    V[g] = m[g] / rho[g];
+  }
+}
+
+/* Pass A: Gamma, grad Gamma, B = L^-1, raw gradients of P and u, div u, grad C,
+ * U_char; then L, the renormalised gradients (Eq. 14) and lambda, per particle. */
+static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *dx = p->dx;
+  const real *P = s->P, *V = s->V;
+  real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D,
+       *gC = s->gC, *uch = s->uch, *lam = s->lam;
+  const int kern = s->kernel;
+  const real ratio = s->ratio;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
+    const real uxi = ux[i], uyi = uy[i], Pi = P[i], dxi = dx[i];
+    real g = rhod_W(kern, 0, Ri) * V[i]; /* self term of Eq. 7 */
+    real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
+    real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0,
+         um = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+      if (r2 < R2 && j != i) {
+        const real r = sqrt(r2), ir = 1 / r;
+        const real nx = rx * ir, ny = ry * ir;
+        const real Vj = V[j];
+        const real F = -rhod_dW(kern, r, Ri) * Vj; /* |grad_i W_ij| V_j */
+        const real Wv = rhod_W(kern, r, Ri) * Vj;
+        const real gwx = F * nx, gwy = F * ny;
+        g += Wv;                                  /* Eq. 7 */
+        ggx += gwx, ggy += gwy;                   /* Eq. 27 */
+        B0 += rx * gwx, B1 += rx * gwy;           /* Eq. 8: B_ab = sum r_a g_b V */
+        B2 += ry * gwx, B3 += ry * gwy;
+        const real dP = P[j] - Pi, dux = ux[j] - uxi, duy = uy[j] - uyi;
+        GPx += dP * gwx, GPy += dP * gwy;         /* Eq. 14, raw */
+        Gu0 += dux * gwx, Gu1 += dux * gwy;
+        Gu2 += duy * gwx, Gu3 += duy * gwy;
+        div += dux * gwx + duy * gwy;             /* Eq. 5 */
+        /* Eq. 29: [1 + 0.2 (W_ij / W(dx_ij))^4] grad_i W_ij V_j, W(dx_ij) with R_i */
+        const real wr = rhod_W(kern, r, Ri) / rhod_W(kern, (real)0.5 * (dxi + dx[j]), Ri);
+        const real f = 1 + (real)0.2 * wr * wr * wr * wr;
+        cx += f * gwx, cy += f * gwy;
+        const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
+        um = un > um ? un : um;
+      }
+    }
+    RHOD_END_NEIGHBOURS
+    gam[i] = g;
+    ggam[2 * i] = ggx, ggam[2 * i + 1] = ggy;
+    D[i] = div;
+    gC[2 * i] = cx, gC[2 * i + 1] = cy;
+    uch[i] = um;
+    const real Bm[4] = {B0, B1, B2, B3};
+    lam[i] = rhod_min_eig_sym(Bm);
+    /* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
+     * invert: isolated particles, thin jets) L = identity, so the gradients fall
+     * back to the plain SPH sums. */
+    const real det = B0 * B3 - B1 * B2;
+    real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
+    if (det > (real)1e-2) {
+      const real id = 1 / det;
+      L0 = B3 * id, L1 = -B1 * id, L2 = -B2 * id, L3 = B0 * id;
+    }
+    L[4 * i] = L0, L[4 * i + 1] = L1, L[4 * i + 2] = L2, L[4 * i + 3] = L3;
+    /* exact for linear fields: sum (a.r) g V = B^T a, so grad = L^T G (scheme.md) */
+    gP[2 * i] = L0 * GPx + L2 * GPy;
+    gP[2 * i + 1] = L1 * GPx + L3 * GPy;
+    gu[4 * i] = L0 * Gu0 + L2 * Gu1;
+    gu[4 * i + 1] = L1 * Gu0 + L3 * Gu1;
+    gu[4 * i + 2] = L0 * Gu2 + L2 * Gu3;
+    gu[4 * i + 3] = L1 * Gu2 + L3 * Gu3;
+  }
+}
+
+/* Ghost copies of the pass A gradients: grad P' = J grad P + rho (I - J) g for the
+ * hydrostatic-corrected ghost pressure, grad u' = T (grad u) J^T, div u' = tr grad u'. */
+static void mirror_gradients(rhod_sph *s, rhod_particles *p) {
+  const long n = (long)p->n, nt = (long)(p->n + p->ng);
+  const int32_t *gsrc = p->gsrc;
+  const real *gJ = p->gJ, *gT = p->gT, *rho = p->rho;
+  real *gP = s->gP, *gu = s->gu, *D = s->D;
+  const real gx = s->gx, gy = s->gy;
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++) {
+    const int k = gsrc[g];
+    const real *J = gJ + 4 * g, *T = gT + 4 * g;
+    const real px = gP[2 * k], py = gP[2 * k + 1];
+    const real Jgx = J[0] * gx + J[1] * gy, Jgy = J[2] * gx + J[3] * gy;
+    gP[2 * g] = J[0] * px + J[1] * py + rho[k] * (gx - Jgx);
+    gP[2 * g + 1] = J[2] * px + J[3] * py + rho[k] * (gy - Jgy);
+    const real *U = gu + 4 * k;
+    /* M = T U */
+    const real M0 = T[0] * U[0] + T[1] * U[2], M1 = T[0] * U[1] + T[1] * U[3];
+    const real M2 = T[2] * U[0] + T[3] * U[2], M3 = T[2] * U[1] + T[3] * U[3];
+    /* M J^T */
+    real *O = gu + 4 * g;
+    O[0] = M0 * J[0] + M1 * J[1];
+    O[1] = M0 * J[2] + M1 * J[3];
+    O[2] = M2 * J[0] + M3 * J[1];
+    O[3] = M2 * J[2] + M3 * J[3];
+    /* div u of the ghost: the source's own (raw, Eq. 5) value where the map keeps it
+     * (T = J: free slip, periodic), else the trace of the mapped gradient (no slip) */
+    const int same = T[0] == J[0] && T[1] == J[1] && T[2] == J[2] && T[3] == J[3];
+    D[g] = same ? D[k] : O[0] + O[3];
+  }
+}
+
+/* Free-surface detection of Marrone et al. 2010 (paper 002 Ref. 51; scheme.md step 3):
+ * lambda <= lam_lo: surface; > lam_hi: not; between: the scan-region test. */
+static void pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n;
+  uint8_t *fs = s->fs;
+  real *nrm = s->nrm;
+  const real *lam = s->lam, *L = s->L, *ggam = s->ggam, *x = p->x, *y = p->y, *dx = p->dx;
+  if (!s->fsdetect) {
+    RHOD_KERNEL_LOOP
+    for (long i = 0; i < n; i++) {
+      fs[i] = 0;
+      nrm[2 * i] = 0, nrm[2 * i + 1] = 0;
+    }
+    return;
+  }
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real lo = s->lam_lo, hi = s->lam_hi, ratio = s->ratio;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    /* normal n = -L^T grad Gamma / |.| (outward) */
+    const real *Li = L + 4 * i;
+    const real gx = ggam[2 * i], gy = ggam[2 * i + 1];
+    real nx = -(Li[0] * gx + Li[2] * gy), ny = -(Li[1] * gx + Li[3] * gy);
+    const real nn = sqrt(nx * nx + ny * ny);
+    if (nn > 0) {
+      nx /= nn, ny /= nn;
+    } else {
+      nx = 0, ny = 0;
+    }
+    nrm[2 * i] = nx, nrm[2 * i + 1] = ny;
+    const real l = lam[i];
+    if (l <= lo) {
+      fs[i] = 1;
+      continue;
+    }
+    if (l > hi || nn == 0) {
+      fs[i] = 0;
+      continue;
+    }
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], h = (real)0.5 * Ri;
+    const real Tx = xi + h * nx, Ty = yi + h * ny;
+    const real tx = -ny, ty = nx;
+    const real h2 = h * h, s2h2 = 2 * h2, R2 = Ri * Ri;
+    int occupied = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+      if (j != i && r2 < R2) {
+        const real qx = x[j] - Tx, qy = y[j] - Ty;
+        if (r2 >= s2h2) {
+          if (qx * qx + qy * qy < h2) occupied = 1;
+        } else if (fabs(nx * qx + ny * qy) + fabs(tx * qx + ty * qy) < h) {
+          occupied = 1;
+        }
+      }
+    }
+    RHOD_END_NEIGHBOURS
+    fs[i] = occupied ? 0 : 1;
+  }
+}
+
+/* Ghosts take the flags and normals of their sources (normal mirrored with J). */
+static void mirror_surface(rhod_sph *s, rhod_particles *p) {
+  const long n = (long)p->n, nt = (long)(p->n + p->ng);
+  const int32_t *gsrc = p->gsrc;
+  const real *gJ = p->gJ;
+  uint8_t *fs = s->fs;
+  real *nrm = s->nrm;
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++) {
+    const int k = gsrc[g];
+    const real *J = gJ + 4 * g;
+    fs[g] = fs[k];
+    const real nx = nrm[2 * k], ny = nrm[2 * k + 1];
+    nrm[2 * g] = J[0] * nx + J[1] * ny;
+    nrm[2 * g + 1] = J[2] * nx + J[3] * ny;
+  }
+}
+
+/* Free-surface region (F u V) and the projection of Eq. 26. Our choice for the
+ * quantities paper 002 takes from its Ref. 55: n~_i = the W-weighted mean of the
+ * normals of the free-surface particles in the support (i itself included when in F),
+ * normalised; sigma_i = 1 on F and 1 - d_i/R_i on V, d_i the distance to the nearest
+ * free-surface particle, so the projection fades out continuously across V. */
+static void pass_region(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n;
+  uint8_t *reg = s->reg;
+  real *nt = s->nt, *sig = s->sig;
+  const uint8_t *fs = s->fs;
+  const real *nrm = s->nrm, *x = p->x, *y = p->y, *dx = p->dx;
+  if (!s->fsdetect) {
+    RHOD_KERNEL_LOOP
+    for (long i = 0; i < n; i++) {
+      reg[i] = 0, sig[i] = 0;
+      nt[2 * i] = 0, nt[2 * i + 1] = 0;
+    }
+    return;
+  }
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const int kern = s->kernel;
+  const real ratio = s->ratio;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
+    real sx = 0, sy = 0, dmin2 = R2;
+    int any = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+      if (r2 < R2 && fs[j]) {
+        const real w = rhod_W(kern, sqrt(r2), Ri);
+        sx += w * nrm[2 * j], sy += w * nrm[2 * j + 1];
+        if (j != i && r2 < dmin2) dmin2 = r2;
+        any = 1;
+      }
+    }
+    RHOD_END_NEIGHBOURS
+    const real sn = sqrt(sx * sx + sy * sy);
+    if (fs[i]) {
+      reg[i] = 2, sig[i] = 1;
+    } else if (any) {
+      reg[i] = 1, sig[i] = 1 - sqrt(dmin2) / Ri;
+    } else {
+      reg[i] = 0, sig[i] = 0;
+    }
+    nt[2 * i] = sn > 0 ? sx / sn : 0;
+    nt[2 * i + 1] = sn > 0 ? sy / sn : 0;
+  }
+}
+
+/* Shifting velocity, Eqs. 25-27 (no gather: grad C and U_char come from pass A). */
+static void pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
+  const long n = (long)p->n, nt_ = (long)(p->n + p->ng);
+  real *du = s->du;
+  if (!s->shifting) {
+    RHOD_KERNEL_LOOP
+    for (long i = 0; i < nt_; i++) du[2 * i] = 0, du[2 * i + 1] = 0;
+    return;
+  }
+  const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *uch = s->uch, *ggam = s->ggam,
+             *dx = p->dx;
+  const real ratio = s->ratio, a = s->sa, b = s->sb, eps = s->seps;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const real Ri = ratio * dx[i];
+    real Jx = -Ri * gC[2 * i], Jy = -Ri * gC[2 * i + 1]; /* Eq. 25 */
+    const real nx = nt[2 * i], ny = nt[2 * i + 1];
+    const real jn = sig[i] * (Jx * nx + Jy * ny); /* Eq. 26 */
+    Jx -= jn * nx, Jy -= jn * ny;
+    const real jm = sqrt(Jx * Jx + Jy * Jy);
+    real f = a * uch[i]; /* Eq. 27 */
+    if (jm > 0) {
+      const real f2 = b * ratio * uch[i] / jm;
+      f = f2 < f ? f2 : f;
+      const real jg = fabs(Jx * ggam[2 * i] + Jy * ggam[2 * i + 1]);
+      if (jg > 0) {
+        const real f3 = eps / (2 * dt * jg);
+        f = f3 < f ? f3 : f;
+      }
+    }
+    du[2 * i] = f * Jx, du[2 * i + 1] = f * Jy;
+  }
+  const int32_t *gsrc = p->gsrc;
+  const real *gJ = p->gJ;
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt_; g++) {
+    const int k = gsrc[g];
+    const real *J = gJ + 4 * g;
+    const real vx = du[2 * k], vy = du[2 * k + 1];
+    du[2 * g] = J[0] * vx + J[1] * vy;
+    du[2 * g + 1] = J[2] * vx + J[3] * vy;
+  }
+}
+
+/* Pass C: the right-hand side of Eq. 3. */
+static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *dx = p->dx;
+  const real *P = s->P, *V = s->V, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D,
+             *du = s->du, *gam = s->gam;
+  const uint8_t *reg = s->reg;
+  real *drho = s->drho, *acc = s->acc, *vel = s->vel;
+  const int kern = s->kernel, riemann = s->riemann, recon = s->recon, damper = s->damper,
+            shifting = s->shifting;
+  const real ratio = s->ratio, c0 = s->c0, rho0 = s->rho0, ic2 = 1 / (s->c0 * s->c0);
+  const real mu = s->mu, alpha_mu = s->mu != 0 ? 1 : 0, gx = s->gx, gy = s->gy;
+  const real alpha_ad = s->alpha_ad, gth = s->gamma_th, tth = s->theta_th;
+  const real visc_k = 2 * (RHOD_DIM + 2) * mu; /* Eq. 10 */
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const real xi = x[i], yi = y[i], dxi = dx[i], Ri = ratio * dxi, R2 = Ri * Ri;
+    const real uxi = ux[i], uyi = uy[i], rhoi = rho[i], Pi = P[i], Di = D[i];
+    const real dui = du[2 * i], dvi = du[2 * i + 1];
+    const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];
+    const real *Gi = gu + 4 * i;
+    real pmx = 0, pmy = 0, ppx = 0, ppy = 0; /* sums of Eq. 6, both forms */
+    real thx = 0, thy = 0;                   /* sum theta_ij grad W V, Eq. 24 */
+    real cont = 0;                           /* continuity, Eq. 22 */
+    real adx = 0, ady = 0;                   /* Eq. 9 */
+    real vsx = 0, vsy = 0;                   /* Eq. 10 */
+    real ddu = 0, drdu = 0, ruux = 0, ruuy = 0; /* Eq. 4 */
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+      if (r2 < R2 && j != i) {
+        const real r = sqrt(r2), ir = 1 / r;
+        const real nx = rx * ir, ny = ry * ir;
+        const real F = -rhod_dW(kern, r, Ri) * V[j]; /* |grad_i W_ij| V_j */
+        const real Pj = P[j];
+        pmx += (Pj - Pi) * F * nx, pmy += (Pj - Pi) * F * ny;
+        ppx += (Pj + Pi) * F * nx, ppy += (Pj + Pi) * F * ny;
+        const real uni = uxi * nx + uyi * ny, unj = ux[j] * nx + uy[j] * ny;
+        /* weights of Eq. 12: w_i = dx_i / (dx_i + dx_j) */
+        const real wi = dxi / (dxi + dx[j]), wj = 1 - wi;
+        if (riemann) {
+          /* states of Eqs. 13-16 for P and the normal velocity u.n_ij */
+          const real *Gj = gu + 4 * j;
+          const real gPi_n = gPix * nx + gPiy * ny;
+          const real gPj_n = gP[2 * j] * nx + gP[2 * j + 1] * ny;
+          const real gui_n = nx * (Gi[0] * nx + Gi[1] * ny) + ny * (Gi[2] * nx + Gi[3] * ny);
+          const real guj_n = nx * (Gj[0] * nx + Gj[1] * ny) + ny * (Gj[2] * nx + Gj[3] * ny);
+          real PL, PR, uL, uR, uE, PE;
+          rhod_states(Pi, Pj, gPi_n, gPj_n, r, wi, wj, recon, &PL, &PR);
+          rhod_states(uni, unj, gui_n, guj_n, r, wi, wj, recon, &uL, &uR);
+          rhod_pvrs(rho0 + PL * ic2, rho0 + PR * ic2, uL, uR, PL, PR, c0, &uE, &PE);
+          /* Eq. 22: -rho_i <div u> + Theta^rho = -2 rho_i sum (u_E + R_ij).n F V,
+           * R_ij = -(3/2 - w_i) u_i - (1/2 - w_j) u_j */
+          cont += (uE - ((real)1.5 - wi) * uni - ((real)0.5 - wj) * unj) * F;
+          /* Eq. 24: theta_ij = 2 (P_E - [(1 - w_i) P_i + (1 - w_j) P_j]) */
+          const real th = 2 * (PE - ((1 - wi) * Pi + (1 - wj) * Pj));
+          thx += th * F * nx, thy += th * F * ny;
+        }
+        if (damper) {
+          adx += (D[j] + Di) * F * nx, ady += (D[j] + Di) * F * ny;
+        }
+        if (visc_k != 0) {
+          /* pi_ij of Eq. 10 */
+          const real pij = ((ux[j] - uxi) * rx + (uy[j] - uyi) * ry) / r2;
+          vsx += pij * F * nx, vsy += pij * F * ny;
+        }
+        if (shifting) {
+          const real duj = du[2 * j], dvj = du[2 * j + 1], rhoj = rho[j];
+          const real dun_i = dui * nx + dvi * ny, dun_j = duj * nx + dvj * ny;
+          ddu += (dun_j - dun_i) * F;
+          drdu += (rhoi * dun_i + rhoj * dun_j) * F;
+          ruux += (rhoi * uxi * dun_i + rhoj * ux[j] * dun_j) * F;
+          ruuy += (rhoi * uyi * dun_i + rhoj * uy[j] * dun_j) * F;
+        }
+      }
+    }
+    RHOD_END_NEIGHBOURS
+    const real *Li = L + 4 * i;
+    const int inner = reg[i] == 0;
+    /* Eq. 6: renormalised in the bulk, conservative near the surface */
+    real gpx, gpy;
+    if (inner && gam[i] >= gth) {
+      gpx = Li[0] * pmx + Li[2] * pmy;
+      gpy = Li[1] * pmx + Li[3] * pmy;
+    } else {
+      gpx = ppx, gpy = ppy;
+    }
+    real fx = -gpx + rhoi * gx, fy = -gpy + rhoi * gy;
+    real dr;
+    if (riemann) {
+      dr = -2 * rhoi * cont;
+      /* Eq. 24 and the alpha_mu exclusion of Eq. 3 */
+      if (alpha_mu == 0) {
+        if (inner && gam[i] > tth) {
+          fx -= Li[0] * thx + Li[2] * thy;
+          fy -= Li[1] * thx + Li[3] * thy;
+        } else {
+          fx -= thx, fy -= thy;
+        }
+      }
+    } else {
+      dr = -rhoi * Di;
+    }
+    if (damper) { /* Eq. 9, h_i = R_i / 2 */
+      const real k = alpha_ad * rho0 * c0 * (real)0.5 * Ri;
+      fx += k * adx, fy += k * ady;
+    }
+    if (visc_k != 0) fx += alpha_mu * visc_k * vsx, fy += alpha_mu * visc_k * vsy;
+    if (shifting) { /* Eq. 4 */
+      dr += -rhoi * ddu + drdu;
+      fx += ruux, fy += ruuy;
+    }
+    drho[i] = dr;
+    acc[2 * i] = fx / rhoi, acc[2 * i + 1] = fy / rhoi;
+    vel[2 * i] = uxi + dui, vel[2 * i + 1] = uyi + dvi;
+  }
+}
+
+void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, const rhod_cells *c, real dt) {
+  pass_a(s, p, c);
+  mirror_gradients(s, p);
+  pass_free_surface(s, p, c);
+  mirror_surface(s, p);
+  pass_region(s, p, c);
+  pass_shift(s, p, dt);
+  pass_c(s, p, c);
+}
+
+real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {
+  const long n = (long)p->n;
+  const real *dx = p->dx;
+  real dmin = (real)FLT_MAX;
+  RHOD_KERNEL_LOOP_REDUCE(min, dmin)
+  for (long i = 0; i < n; i++) dmin = dx[i] < dmin ? dx[i] : dmin;
+  const real R = s->ratio * dmin;
+  /* Eq. 11 */
+  real dt = s->cfl * R / s->c0;
+  if (s->damper && s->alpha_ad > 0) {
+    const real d2 = s->cfl * R / (s->alpha_ad * s->c0);
+    dt = d2 < dt ? d2 : dt;
+  }
+  if (s->mu > 0) {
+    const real d3 = s->cfl_visc * s->rho0 * R * R / s->mu;
+    dt = d3 < dt ? d3 : dt;
+  }
+  return dt;
+}

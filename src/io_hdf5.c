@@ -1,0 +1,677 @@
+/* HDF5 snapshots in a SWIFT-like layout (see io.h): built in memory, then written under a
+ * temporary name in the output folder and renamed once complete and synced; read back
+ * for tests and tools. HDF5's automatic error printing is switched off; failures become
+ * one-line messages built from the HDF5 error stack (the system errno where the stack
+ * records one). */
+#define _POSIX_C_SOURCE 200809L
+
+#include "rhod/io.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <hdf5.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* ---------------------------------------------------------------- errors */
+
+typedef struct {
+  int noted, have_desc, sys_errno;
+  char desc[160];
+} h5_reason;
+
+static herr_t walk_cb(unsigned n, const H5E_error2_t *e, void *data) {
+  h5_reason *r = data;
+  if (!e->desc)
+    return 0;
+  if (n == 0 && !r->have_desc) {
+    snprintf(r->desc, sizeof r->desc, "%s", e->desc);
+    r->have_desc = 1;
+  }
+  const char *s = strstr(e->desc, "errno = ");
+  if (s && !r->sys_errno) {
+    int v = atoi(s + 8);
+    if (v > 0)
+      r->sys_errno = v;
+  }
+  return 0;
+}
+
+/* Records why the HDF5 call that just failed failed (the first failure only). Must come
+ * right after that call: every HDF5 API call clears the error stack on entry. */
+static void note(h5_reason *r) {
+  if (r->noted)
+    return;
+  r->noted = 1;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, walk_cb, r);
+  H5Eclear2(H5E_DEFAULT);
+}
+
+/* The reason as text: the system error when the stack held one, else the innermost HDF5
+ * message. */
+static void reason_text(const h5_reason *r, char *buf, size_t len) {
+  if (r->sys_errno)
+    snprintf(buf, len, "%s", strerror(r->sys_errno));
+  else if (r->have_desc)
+    snprintf(buf, len, "%s", r->desc);
+  else
+    snprintf(buf, len, "HDF5 error");
+}
+
+static void set_err(char *err, size_t errlen, const char *fmt, ...) {
+  if (!err || !errlen)
+    return;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(err, errlen, fmt, ap);
+  va_end(ap);
+}
+
+static void h5_quiet(void) { H5Eset_auto2(H5E_DEFAULT, NULL, NULL); }
+
+/* ---------------------------------------------------------------- writing */
+
+static char *join_path(const char *dir, const char *name) {
+  size_t dl = dir ? strlen(dir) : 0, nl = strlen(name);
+  char *s = malloc(dl + nl + 2);
+  if (!s)
+    return NULL;
+  size_t k = 0;
+  if (dl) {
+    memcpy(s, dir, dl);
+    k = dl;
+    if (s[k - 1] != '/')
+      s[k++] = '/';
+  }
+  memcpy(s + k, name, nl + 1);
+  return s;
+}
+
+static int write_attr(h5_reason *R, hid_t loc, const char *name, hid_t ftype, hid_t mtype,
+                      const void *val) {
+  hid_t sp = H5Screate(H5S_SCALAR);
+  if (sp < 0) {
+    note(R);
+    return -1;
+  }
+  int rc = -1;
+  hid_t a = H5Acreate2(loc, name, ftype, sp, H5P_DEFAULT, H5P_DEFAULT);
+  if (a < 0) {
+    note(R);
+  } else {
+    rc = 0;
+    if (H5Awrite(a, mtype, val) < 0) {
+      note(R);
+      rc = -1;
+    }
+    if (H5Aclose(a) < 0) {
+      note(R);
+      rc = -1;
+    }
+  }
+  H5Sclose(sp);
+  return rc;
+}
+
+static int write_str_attr(h5_reason *R, hid_t loc, const char *name, const char *val) {
+  hid_t t = H5Tcopy(H5T_C_S1);
+  if (t < 0) {
+    note(R);
+    return -1;
+  }
+  int rc = -1;
+  if (H5Tset_size(t, strlen(val) + 1) >= 0 && H5Tset_strpad(t, H5T_STR_NULLTERM) >= 0)
+    rc = write_attr(R, loc, name, t, t, val);
+  else
+    note(R);
+  H5Tclose(t);
+  return rc;
+}
+
+/* A contiguous (default creation properties: no chunks, no filters) dataset of rank 1
+ * (cols == 0) or n x cols. */
+static int write_dataset(h5_reason *R, hid_t loc, const char *name, hid_t ftype, hid_t mtype,
+                         size_t n, unsigned cols, const void *buf) {
+  hsize_t dims[2] = {(hsize_t)n, (hsize_t)cols};
+  hid_t sp = H5Screate_simple(cols ? 2 : 1, dims, NULL);
+  if (sp < 0) {
+    note(R);
+    return -1;
+  }
+  int rc = -1;
+  hid_t d = H5Dcreate2(loc, name, ftype, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (d < 0) {
+    note(R);
+  } else {
+    rc = 0;
+    if (n > 0 && H5Dwrite(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {
+      note(R);
+      rc = -1;
+    }
+    if (H5Dclose(d) < 0) {
+      note(R);
+      rc = -1;
+    }
+  }
+  H5Sclose(sp);
+  return rc;
+}
+
+static void to_double(double *out, const real *in, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    out[i] = (double)in[i];
+}
+
+static void pack_xyz(double *out, const real *a, const real *b, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    out[3 * i] = (double)a[i];
+    out[3 * i + 1] = (double)b[i];
+    out[3 * i + 2] = 0.0;
+  }
+}
+
+static hid_t create_group(h5_reason *R, hid_t loc, const char *name, hid_t gcpl) {
+  hid_t g = H5Gcreate2(loc, name, H5P_DEFAULT, gcpl, H5P_DEFAULT);
+  if (g < 0)
+    note(R);
+  return g;
+}
+
+static int close_group(h5_reason *R, hid_t g, int rc) {
+  if (H5Gclose(g) < 0) {
+    note(R);
+    rc = -1;
+  }
+  return rc;
+}
+
+static int write_particles(h5_reason *R, hid_t file, const rhod_snapshot_view *v, double *buf) {
+  hid_t g = create_group(R, file, "PartType0", H5P_DEFAULT);
+  if (g < 0)
+    return -1;
+  const hid_t F = H5T_IEEE_F64LE, M = H5T_NATIVE_DOUBLE;
+  size_t n = v->n;
+  pack_xyz(buf, v->x, v->y, n);
+  int rc = write_dataset(R, g, "Coordinates", F, M, n, 3, buf);
+  if (!rc) {
+    pack_xyz(buf, v->ux, v->uy, n);
+    rc = write_dataset(R, g, "Velocities", F, M, n, 3, buf);
+  }
+  struct {
+    const char *name;
+    const real *a;
+  } scalars[] = {
+      {"Densities", v->rho}, {"Pressures", v->p}, {"Masses", v->m}, {"ParticleSizes", v->size}};
+  for (size_t k = 0; k < sizeof scalars / sizeof scalars[0] && !rc; k++) {
+    to_double(buf, scalars[k].a, n);
+    rc = write_dataset(R, g, scalars[k].name, F, M, n, 0, buf);
+  }
+  if (!rc)
+    rc = write_dataset(R, g, "ParticleIDs", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 0, v->id);
+  if (!rc && v->fs)
+    rc = write_dataset(R, g, "FreeSurface", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, v->fs);
+  return close_group(R, g, rc);
+}
+
+static int write_header(h5_reason *R, hid_t file, const rhod_snapshot_view *v) {
+  hid_t g = create_group(R, file, "Header", H5P_DEFAULT);
+  if (g < 0)
+    return -1;
+  int dim = RHOD_DIM;
+  uint64_t np = (uint64_t)v->n;
+  int rc = write_attr(R, g, "Time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &v->time);
+  if (!rc)
+    rc = write_attr(R, g, "Dimension", H5T_STD_I32LE, H5T_NATIVE_INT, &dim);
+  if (!rc)
+    rc = write_attr(R, g, "NumPart", H5T_STD_U64LE, H5T_NATIVE_UINT64, &np);
+  if (!rc)
+    rc = write_str_attr(R, g, "Code", "rhod");
+  if (!rc)
+    rc = write_str_attr(R, g, "Precision", RHOD_REAL_NAME);
+  return close_group(R, g, rc);
+}
+
+static int write_params(h5_reason *R, hid_t file, const rhod_param_list *params) {
+  /* Creation order is tracked so that a reader gets the keys back in scene order. */
+  hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
+  if (gcpl < 0) {
+    note(R);
+    return -1;
+  }
+  if (H5Pset_attr_creation_order(gcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0) {
+    note(R);
+    H5Pclose(gcpl);
+    return -1;
+  }
+  hid_t g = create_group(R, file, "Parameters", gcpl);
+  H5Pclose(gcpl);
+  if (g < 0)
+    return -1;
+  int rc = 0;
+  for (unsigned i = 0; params && i < params->n && !rc; i++)
+    rc = write_str_attr(R, g, params->keys[i], params->values[i] ? params->values[i] : "");
+  return close_group(R, g, rc);
+}
+
+/* Builds the whole file in memory (core driver, no backing store) and returns its image.
+ * HDF5 never touches the disk, so a full disk cannot leave a half-closed HDF5 file behind
+ * (HDF5 1.10 keeps such a file open and crashes at exit); the image is then written with
+ * rhod_write_bytes_atomic, whose errors are plain errno values. */
+static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_view *v,
+                         const rhod_param_list *params, size_t *size, int *oom) {
+  *size = 0;
+  *oom = 0;
+  size_t n = v->n;
+  double *buf = malloc(3 * (n ? n : 1) * sizeof *buf);
+  if (!buf) {
+    *oom = 1;
+    return NULL;
+  }
+  /* one allocation of the core driver for the whole file, most of the time */
+  size_t increment = n * (6 * sizeof(double) + 4 * sizeof(double) + 9) + (1u << 16);
+  hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  hid_t file = -1;
+  if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0 &&
+      H5Pset_fapl_core(fapl, increment, 0) >= 0)
+    file = H5Fcreate(name, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+  if (file < 0)
+    note(R);
+  if (fapl >= 0)
+    H5Pclose(fapl);
+  int bad = file < 0;
+  if (!bad)
+    bad = write_header(R, file, v) != 0;
+  if (!bad)
+    bad = write_particles(R, file, v, buf) != 0;
+  free(buf);
+  if (!bad)
+    bad = write_params(R, file, params) != 0;
+  void *image = NULL;
+  if (!bad && H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) {
+    note(R);
+    bad = 1;
+  }
+  if (!bad) {
+    ssize_t len = H5Fget_file_image(file, NULL, 0);
+    if (len <= 0) {
+      note(R);
+    } else if ((image = malloc((size_t)len)) == NULL) {
+      *oom = 1;
+    } else if (H5Fget_file_image(file, image, (size_t)len) != len) {
+      note(R);
+      free(image);
+      image = NULL;
+    } else {
+      *size = (size_t)len;
+    }
+  }
+  if (file >= 0 && H5Fclose(file) < 0) {
+    note(R);
+    free(image);
+    image = NULL;
+  }
+  return image;
+}
+
+int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
+                        const rhod_param_list *params, char *err, size_t errlen) {
+  char name[64];
+  if (index < 0) {
+    set_err(err, errlen, "snapshot index %d: must not be negative", index);
+    return RHOD_ERR_IO;
+  }
+  snprintf(name, sizeof name, "snapshot_%04d.h5", index);
+  char *path = join_path(dir, name);
+  if (!path) {
+    set_err(err, errlen, "%s: cannot write: out of memory", name);
+    return RHOD_ERR_MEMORY;
+  }
+  if (v->n > 0 &&
+      (!v->x || !v->y || !v->ux || !v->uy || !v->rho || !v->p || !v->m || !v->size || !v->id)) {
+    set_err(err, errlen, "%s: cannot write: a particle field is missing", path);
+    free(path);
+    return RHOD_ERR_IO;
+  }
+  h5_quiet();
+  h5_reason R = {0, 0, 0, ""};
+  size_t size = 0;
+  int oom = 0;
+  void *image = build_image(&R, path, v, params, &size, &oom);
+  int rc;
+  if (!image) {
+    char reason[200] = "out of memory";
+    if (!oom)
+      reason_text(&R, reason, sizeof reason);
+    set_err(err, errlen, "%s: cannot write: %s", path, reason);
+    rc = oom ? RHOD_ERR_MEMORY : RHOD_ERR_IO;
+  } else {
+    rc = rhod_write_bytes_atomic(path, image, size, err, errlen);
+  }
+  H5Eclear2(H5E_DEFAULT);
+  free(image);
+  free(path);
+  return rc;
+}
+
+/* ---------------------------------------------------------------- reading */
+
+typedef struct {
+  hid_t file;
+  const char *path;
+  char *err;
+  size_t errlen;
+} reader;
+
+/* Reports the HDF5 failure that just happened (call it before any other HDF5 call). */
+static int rfail(reader *r, const char *what) {
+  char reason[200];
+  h5_reason R = {0, 0, 0, ""};
+  note(&R);
+  reason_text(&R, reason, sizeof reason);
+  set_err(r->err, r->errlen, "%s: cannot read %s: %s", r->path, what, reason);
+  return RHOD_ERR_READ;
+}
+
+/* Opens /PartType0/name, checks its shape (n rows; cols columns, 0 for rank 1). */
+static hid_t open_dataset(reader *r, const char *name, size_t n, unsigned cols, int *rc) {
+  char full[96];
+  snprintf(full, sizeof full, "/PartType0/%s", name);
+  if (H5Lexists(r->file, full, H5P_DEFAULT) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen, "%s: missing dataset %s", r->path, full);
+    *rc = RHOD_ERR_READ;
+    return -1;
+  }
+  hid_t d = H5Dopen2(r->file, full, H5P_DEFAULT);
+  if (d < 0) {
+    *rc = rfail(r, full);
+    return -1;
+  }
+  hid_t sp = H5Dget_space(d);
+  hsize_t dims[3] = {0, 0, 0};
+  int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+  if (rank >= 1 && rank <= 2)
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+  if (sp >= 0)
+    H5Sclose(sp);
+  int want_rank = cols ? 2 : 1;
+  if (rank != want_rank || dims[0] != (hsize_t)n || (cols && dims[1] != cols)) {
+    H5Dclose(d);
+    set_err(r->err, r->errlen, "%s: dataset %s has the wrong shape (expected %zu%s)", r->path, full,
+            n, cols == 3 ? " x 3" : "");
+    *rc = RHOD_ERR_READ;
+    return -1;
+  }
+  return d;
+}
+
+static int read_dataset(reader *r, const char *name, size_t n, unsigned cols, hid_t mtype,
+                        void *buf) {
+  int rc = RHOD_OK;
+  hid_t d = open_dataset(r, name, n, cols, &rc);
+  if (d < 0)
+    return rc;
+  if (n > 0 && H5Dread(d, mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {
+    char full[96];
+    snprintf(full, sizeof full, "/PartType0/%s", name);
+    rc = rfail(r, full);
+  }
+  H5Dclose(d);
+  return rc;
+}
+
+static int read_attr(reader *r, hid_t loc, const char *name, hid_t mtype, void *val) {
+  char what[64];
+  snprintf(what, sizeof what, "/Header/%s", name);
+  if (H5Aexists(loc, name) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen, "%s: missing attribute %s", r->path, what);
+    return RHOD_ERR_READ;
+  }
+  hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+  if (a < 0)
+    return rfail(r, what);
+  int rc = H5Aread(a, mtype, val) < 0 ? rfail(r, what) : RHOD_OK;
+  H5Aclose(a);
+  return rc;
+}
+
+typedef struct {
+  rhod_param_list *list;
+  unsigned cap;
+  int failed;
+} param_iter;
+
+static char *read_string_attr(hid_t a) {
+  hid_t ft = H5Aget_type(a);
+  if (ft < 0)
+    return NULL;
+  char *out = NULL;
+  if (H5Tget_class(ft) == H5T_STRING) {
+    if (H5Tis_variable_str(ft) > 0) {
+      hid_t mt = H5Tcopy(H5T_C_S1);
+      char *s = NULL;
+      if (mt >= 0 && H5Tset_size(mt, H5T_VARIABLE) >= 0 && H5Aread(a, mt, &s) >= 0) {
+        out = strdup(s ? s : "");
+        hid_t sp = H5Aget_space(a);
+        if (sp >= 0) {
+#if H5_VERSION_GE(1, 12, 0)
+          H5Treclaim(mt, sp, H5P_DEFAULT, &s);
+#else
+          H5Dvlen_reclaim(mt, sp, H5P_DEFAULT, &s);
+#endif
+          H5Sclose(sp);
+        }
+      }
+      if (mt >= 0)
+        H5Tclose(mt);
+    } else {
+      size_t sz = H5Tget_size(ft);
+      char *s = calloc(sz + 1, 1);
+      if (s && H5Aread(a, ft, s) >= 0)
+        out = s;
+      else
+        free(s);
+    }
+  }
+  H5Tclose(ft);
+  return out;
+}
+
+static herr_t param_cb(hid_t loc, const char *name, const H5A_info_t *info, void *data) {
+  (void)info;
+  param_iter *it = data;
+  hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+  if (a < 0) {
+    it->failed = 1;
+    return -1;
+  }
+  char *val = read_string_attr(a);
+  H5Aclose(a);
+  if (!val)
+    return 0; /* not a string attribute: not a parameter */
+  rhod_param_list *l = it->list;
+  if (l->n == it->cap) {
+    unsigned cap = it->cap ? 2 * it->cap : 16;
+    char **k = realloc(l->keys, cap * sizeof *k);
+    if (k)
+      l->keys = k;
+    char **v = realloc(l->values, cap * sizeof *v);
+    if (v)
+      l->values = v;
+    if (!k || !v) {
+      free(val);
+      it->failed = 2;
+      return -1;
+    }
+    it->cap = cap;
+  }
+  char *key = strdup(name);
+  if (!key) {
+    free(val);
+    it->failed = 2;
+    return -1;
+  }
+  l->keys[l->n] = key;
+  l->values[l->n] = val;
+  l->n++;
+  return 0;
+}
+
+static int read_params(reader *r, rhod_param_list *out) {
+  if (H5Lexists(r->file, "/Parameters", H5P_DEFAULT) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    return RHOD_OK;
+  }
+  hid_t g = H5Gopen2(r->file, "/Parameters", H5P_DEFAULT);
+  if (g < 0)
+    return rfail(r, "/Parameters");
+  param_iter it = {out, 0, 0};
+  hsize_t idx = 0;
+  herr_t h = H5Aiterate2(g, H5_INDEX_CRT_ORDER, H5_ITER_INC, &idx, param_cb, &it);
+  if (h < 0 && !it.failed && out->n == 0) {
+    /* written without creation-order tracking: name order */
+    H5Eclear2(H5E_DEFAULT);
+    idx = 0;
+    h = H5Aiterate2(g, H5_INDEX_NAME, H5_ITER_INC, &idx, param_cb, &it);
+  }
+  int rc = RHOD_OK;
+  if (it.failed == 2) {
+    set_err(r->err, r->errlen, "%s: out of memory reading /Parameters", r->path);
+    rc = RHOD_ERR_MEMORY;
+  } else if (h < 0 || it.failed) {
+    rc = rfail(r, "/Parameters");
+  }
+  H5Gclose(g);
+  return rc;
+}
+
+static int read_all(reader *r, rhod_snapshot_data *out) {
+  if (H5Lexists(r->file, "/Header", H5P_DEFAULT) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen, "%s: missing group /Header", r->path);
+    return RHOD_ERR_READ;
+  }
+  hid_t h = H5Gopen2(r->file, "/Header", H5P_DEFAULT);
+  if (h < 0)
+    return rfail(r, "/Header");
+  uint64_t np = 0;
+  int dim = 0;
+  int rc = read_attr(r, h, "Time", H5T_NATIVE_DOUBLE, &out->time);
+  if (!rc)
+    rc = read_attr(r, h, "NumPart", H5T_NATIVE_UINT64, &np);
+  if (!rc)
+    rc = read_attr(r, h, "Dimension", H5T_NATIVE_INT, &dim);
+  H5Gclose(h);
+  if (rc)
+    return rc;
+  if (dim != RHOD_DIM) {
+    set_err(r->err, r->errlen, "%s: Dimension is %d, expected %d", r->path, dim, RHOD_DIM);
+    return RHOD_ERR_READ;
+  }
+  if (np > (uint64_t)(SIZE_MAX / (3 * sizeof(double)))) {
+    set_err(r->err, r->errlen, "%s: NumPart %llu is too large", r->path, (unsigned long long)np);
+    return RHOD_ERR_READ;
+  }
+  size_t n = (size_t)np, nn = n ? n : 1;
+  out->n = n;
+  double **fields[] = {&out->x,   &out->y, &out->ux, &out->uy,
+                       &out->rho, &out->p, &out->m,  &out->size};
+  for (size_t k = 0; k < sizeof fields / sizeof fields[0]; k++)
+    if (!(*fields[k] = malloc(nn * sizeof(double))))
+      rc = RHOD_ERR_MEMORY;
+  out->id = malloc(nn * sizeof *out->id);
+  double *buf = malloc(3 * nn * sizeof *buf);
+  if (!out->id || !buf)
+    rc = RHOD_ERR_MEMORY;
+  if (rc) {
+    free(buf);
+    set_err(r->err, r->errlen, "%s: out of memory reading %zu particles", r->path, n);
+    return rc;
+  }
+  const char *vec[2] = {"Coordinates", "Velocities"};
+  double *dst[2][2] = {{out->x, out->y}, {out->ux, out->uy}};
+  for (int k = 0; k < 2 && !rc; k++) {
+    rc = read_dataset(r, vec[k], n, 3, H5T_NATIVE_DOUBLE, buf);
+    for (size_t i = 0; i < n && !rc; i++) {
+      dst[k][0][i] = buf[3 * i];
+      dst[k][1][i] = buf[3 * i + 1];
+    }
+  }
+  free(buf);
+  const char *sc[4] = {"Densities", "Pressures", "Masses", "ParticleSizes"};
+  double *sd[4] = {out->rho, out->p, out->m, out->size};
+  for (int k = 0; k < 4 && !rc; k++)
+    rc = read_dataset(r, sc[k], n, 0, H5T_NATIVE_DOUBLE, sd[k]);
+  if (!rc)
+    rc = read_dataset(r, "ParticleIDs", n, 0, H5T_NATIVE_UINT64, out->id);
+  if (!rc && H5Lexists(r->file, "/PartType0/FreeSurface", H5P_DEFAULT) > 0) {
+    out->fs = malloc(nn);
+    if (!out->fs) {
+      set_err(r->err, r->errlen, "%s: out of memory reading %zu particles", r->path, n);
+      return RHOD_ERR_MEMORY;
+    }
+    rc = read_dataset(r, "FreeSurface", n, 0, H5T_NATIVE_UINT8, out->fs);
+  }
+  H5Eclear2(H5E_DEFAULT);
+  if (!rc)
+    rc = read_params(r, &out->params);
+  return rc;
+}
+
+int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen) {
+  memset(out, 0, sizeof *out);
+  h5_quiet();
+  reader r = {-1, path, err, errlen};
+  /* A plain open first, for a clean "No such file or directory" style reason. */
+  int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    set_err(err, errlen, "%s: cannot read: %s", path, strerror(errno));
+    return RHOD_ERR_READ;
+  }
+  close(fd);
+  hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0)
+    r.file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+  h5_reason R = {0, 0, 0, ""};
+  if (r.file < 0)
+    note(&R);
+  if (fapl >= 0)
+    H5Pclose(fapl);
+  if (r.file < 0) {
+    char reason[200];
+    reason_text(&R, reason, sizeof reason);
+    set_err(err, errlen, "%s: cannot read: %s", path, reason);
+    return RHOD_ERR_READ;
+  }
+  int rc = read_all(&r, out);
+  H5Fclose(r.file);
+  H5Eclear2(H5E_DEFAULT);
+  if (rc)
+    rhod_snapshot_data_free(out);
+  return rc;
+}
+
+void rhod_snapshot_data_free(rhod_snapshot_data *d) {
+  if (!d)
+    return;
+  free(d->x);
+  free(d->y);
+  free(d->ux);
+  free(d->uy);
+  free(d->rho);
+  free(d->p);
+  free(d->m);
+  free(d->size);
+  free(d->id);
+  free(d->fs);
+  for (unsigned i = 0; i < d->params.n; i++) {
+    free(d->params.keys[i]);
+    free(d->params.values[i]);
+  }
+  free(d->params.keys);
+  free(d->params.values);
+  memset(d, 0, sizeof *d);
+}

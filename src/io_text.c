@@ -1,0 +1,207 @@
+/* Text outputs: atomic whole-file writes (path.tmp, fsync, rename) and the probes CSV,
+ * which stays open and is flushed after every row. Every write is checked, so a full
+ * disk is reported as "FILE: cannot write: No space left on device". */
+#define _POSIX_C_SOURCE 200809L
+
+#include "rhod/io.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static int fail(char *err, size_t errlen, const char *path, int errnum) {
+  if (err && errlen)
+    snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errnum));
+  return RHOD_ERR_IO;
+}
+
+/* fsync the directory holding path so that the rename itself is durable. Best effort:
+ * some file systems refuse fsync on a directory, which is not an error for us. */
+static void sync_parent_dir(const char *path) {
+  const char *slash = strrchr(path, '/');
+  char *dir;
+  if (!slash) {
+    dir = strdup(".");
+  } else if (slash == path) {
+    dir = strdup("/");
+  } else {
+    size_t len = (size_t)(slash - path);
+    dir = malloc(len + 1);
+    if (dir) {
+      memcpy(dir, path, len);
+      dir[len] = '\0';
+    }
+  }
+  if (!dir)
+    return;
+  int fd = open(dir, O_RDONLY | O_CLOEXEC);
+  if (fd >= 0) {
+    (void)fsync(fd);
+    (void)close(fd);
+  }
+  free(dir);
+}
+
+int rhod_write_bytes_atomic(const char *path, const void *data, size_t len, char *err,
+                            size_t errlen) {
+  size_t plen = strlen(path);
+  char *tmp = malloc(plen + 5);
+  if (!tmp) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot write: out of memory", path);
+    return RHOD_ERR_MEMORY;
+  }
+  memcpy(tmp, path, plen);
+  memcpy(tmp + plen, ".tmp", 5);
+
+  int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    int e = errno;
+    free(tmp);
+    return fail(err, errlen, path, e);
+  }
+  const unsigned char *p = data;
+  size_t left = len;
+  int e = 0;
+  while (left > 0) {
+    ssize_t w = write(fd, p, left);
+    if (w < 0) {
+      if (errno == EINTR)
+        continue;
+      e = errno;
+      break;
+    }
+    if (w == 0) {
+      e = EIO;
+      break;
+    }
+    p += w;
+    left -= (size_t)w;
+  }
+  if (!e && fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
+    e = errno;
+  if (close(fd) != 0 && !e)
+    e = errno;
+  if (!e && rename(tmp, path) != 0)
+    e = errno;
+  if (e) {
+    (void)unlink(tmp);
+    free(tmp);
+    return fail(err, errlen, path, e);
+  }
+  free(tmp);
+  sync_parent_dir(path);
+  return RHOD_OK;
+}
+
+int rhod_write_file_atomic(const char *path, const char *text, char *err, size_t errlen) {
+  return rhod_write_bytes_atomic(path, text, strlen(text), err, errlen);
+}
+
+/* A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break. */
+static int put_field(FILE *f, const char *s) {
+  if (!strpbrk(s, ",\"\r\n"))
+    return fputs(s, f) < 0 ? -1 : 0;
+  if (fputc('"', f) == EOF)
+    return -1;
+  for (; *s; s++) {
+    if (*s == '"' && fputc('"', f) == EOF)
+      return -1;
+    if (fputc(*s, f) == EOF)
+      return -1;
+  }
+  return fputc('"', f) == EOF ? -1 : 0;
+}
+
+/* Flushes and checks the stream; on failure returns the errno to report. */
+static int flush_check(FILE *f) {
+  errno = 0;
+  if (fflush(f) != 0 || ferror(f))
+    return errno ? errno : EIO;
+  return 0;
+}
+
+int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *const *names,
+                  char *err, size_t errlen) {
+  memset(c, 0, sizeof *c);
+  c->path = strdup(path);
+  if (!c->path) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot write: out of memory", path);
+    return RHOD_ERR_MEMORY;
+  }
+  errno = 0;
+  FILE *f = fopen(path, "w");
+  if (!f) {
+    int e = errno ? errno : EIO;
+    free(c->path);
+    c->path = NULL;
+    return fail(err, errlen, path, e);
+  }
+  int e = 0;
+  errno = 0;
+  if (fputc('t', f) == EOF)
+    e = errno ? errno : EIO;
+  for (unsigned i = 0; i < ncols && !e; i++) {
+    errno = 0;
+    if (fputc(',', f) == EOF || put_field(f, names[i]) != 0)
+      e = errno ? errno : EIO;
+  }
+  errno = 0;
+  if (!e && fputc('\n', f) == EOF)
+    e = errno ? errno : EIO;
+  if (!e)
+    e = flush_check(f);
+  if (e) {
+    (void)fclose(f);
+    free(c->path);
+    c->path = NULL;
+    return fail(err, errlen, path, e);
+  }
+  c->f = f;
+  c->ncols = ncols;
+  return RHOD_OK;
+}
+
+int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen) {
+  if (!c->f) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot write: file not open", c->path ? c->path : "csv");
+    return RHOD_ERR_IO;
+  }
+  int e = 0;
+  errno = 0;
+  if (fprintf(c->f, "%.9g", t) < 0)
+    e = errno ? errno : EIO;
+  for (unsigned i = 0; i < c->ncols && !e; i++) {
+    errno = 0;
+    if (fprintf(c->f, ",%.9g", values[i]) < 0)
+      e = errno ? errno : EIO;
+  }
+  errno = 0;
+  if (!e && fputc('\n', c->f) == EOF)
+    e = errno ? errno : EIO;
+  if (!e)
+    e = flush_check(c->f);
+  if (e)
+    return fail(err, errlen, c->path, e);
+  return RHOD_OK;
+}
+
+int rhod_csv_close(rhod_csv *c, char *err, size_t errlen) {
+  int rc = RHOD_OK;
+  if (c->f) {
+    int e = flush_check(c->f);
+    errno = 0;
+    if (fclose(c->f) != 0 && !e)
+      e = errno ? errno : EIO;
+    if (e)
+      rc = fail(err, errlen, c->path ? c->path : "csv", e);
+  }
+  free(c->path);
+  memset(c, 0, sizeof *c);
+  return rc;
+}

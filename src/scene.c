@@ -1,0 +1,1793 @@
+/* Scene loading: YAML file -> node tree (libyaml, with positions) -> `--set` overrides ->
+ * libcyaml schema validation and load -> value checks, defaults -> rhod_scene.
+ *
+ * libcyaml validates the document against the schema below (unknown keys, missing keys,
+ * types, list lengths, enum names) and reports through its log callback the reason and the
+ * line/column, in the text it was handed, of the event where it stopped. That text is the
+ * tree re-emitted (so that overrides are validated like the file), so the position is
+ * mapped back to the tree node, whose dotted path and position in the scene file (or the
+ * override that supplied it) make the user's one-line message. Every key is documented in
+ * docs/scene.md. */
+#define _POSIX_C_SOURCE 200809L
+
+#include "rhod/scene.h"
+
+#include "scene_yaml.h"
+
+#include <cyaml/cyaml.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* ---- the document as libcyaml loads it (optional values are pointers: NULL = absent) -- */
+
+typedef struct {
+  double min[2], max[2];
+} y_rect;
+
+typedef struct {
+  double center[2];
+  double radius;
+} y_circle;
+
+typedef struct {
+  y_rect *rect;
+  y_circle *circle;
+  double (*polygon)[2];
+  unsigned n_polygon;
+  double *velocity;
+  int *pressure;
+} y_fluid;
+
+typedef struct {
+  y_rect *rect;
+  y_circle *circle;
+  double (*polygon)[2];
+  unsigned n_polygon;
+  int *slip;
+  bool *fluid_inside;
+} y_wall;
+
+typedef struct {
+  double end, output_every;
+  double *cfl, *cfl_visc;
+} y_time;
+
+typedef struct {
+  double dx;
+  double *radius_ratio;
+  int *kernel;
+} y_particles;
+
+typedef struct {
+  double *rho0;
+  double c0;
+  double *mu;
+  double *gravity;
+} y_physics;
+
+typedef struct {
+  bool *riemann, *reconstruction, *shifting;
+  double *shifting_a, *shifting_b, *shifting_eps;
+  bool *acoustic_damper;
+  double *alpha_ad;
+  bool *free_surface;
+  double *free_surface_lambda;
+  double *shepard_threshold, *theta_threshold;
+} y_scheme;
+
+typedef struct {
+  double *min, *max;
+  bool *periodic;
+} y_domain;
+
+typedef struct {
+  char *name;
+  double at[2];
+} y_probe_point;
+
+typedef struct {
+  char *name;
+} y_probe_sum;
+
+typedef struct {
+  char *name;
+  double *direction;
+} y_probe_front;
+
+typedef struct {
+  char *name;
+  double *at;
+} y_probe_angular;
+
+typedef struct {
+  y_probe_point *pressure;
+  y_probe_sum *kinetic_energy, *potential_energy;
+  y_probe_front *front;
+  y_probe_sum *mass, *momentum;
+  y_probe_angular *angular_momentum;
+} y_probe;
+
+typedef struct {
+  double *every;
+  y_probe *list;
+  unsigned n_list;
+} y_probes;
+
+typedef struct {
+  int *field;
+  double *width;
+  double *range;
+} y_picture;
+
+typedef struct {
+  y_picture *picture;
+} y_output;
+
+typedef struct {
+  char *name;
+  y_time time;
+  y_particles particles;
+  y_physics physics;
+  y_scheme *scheme;
+  y_domain *domain;
+  y_fluid *fluid;
+  unsigned n_fluid;
+  y_wall *walls;
+  unsigned n_walls;
+  y_probes *probes;
+  y_output *output;
+} y_doc;
+
+/* ---- the schema ------------------------------------------------------------------------ */
+
+#define OPT (CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL)
+#define NAME_MAX_LEN 64
+
+static const cyaml_schema_value_t sch_float = {CYAML_VALUE_FLOAT(CYAML_FLAG_STRICT, double)};
+static const cyaml_schema_value_t sch_bool = {CYAML_VALUE_BOOL(CYAML_FLAG_DEFAULT, bool)};
+static const cyaml_schema_value_t sch_vec = {
+    CYAML_VALUE_SEQUENCE_FIXED(CYAML_FLAG_FLOW, double, &sch_float, 2)};
+
+#define VEC(key, flags, st, member)                                                              \
+  CYAML_FIELD_SEQUENCE_FIXED(key, (flags) | CYAML_FLAG_FLOW, st, member, &sch_float, 2)
+#define NUM(key, st, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_STRICT, st, member)
+#define NUM_OPT(key, st, member) CYAML_FIELD_FLOAT_PTR(key, OPT | CYAML_FLAG_STRICT, st, member)
+#define BOOL_OPT(key, st, member) CYAML_FIELD_BOOL_PTR(key, OPT, st, member)
+#define ENUM_OPT(key, st, member, strings)                                                       \
+  CYAML_FIELD_ENUM_PTR(key, OPT | CYAML_FLAG_STRICT, st, member, strings,                        \
+                       CYAML_ARRAY_LEN(strings))
+#define NAME_OPT(st) CYAML_FIELD_STRING_PTR("name", OPT, st, name, 1, NAME_MAX_LEN)
+
+static const cyaml_strval_t kernel_names[] = {
+    {"wendland_c2", RHOD_KERNEL_WENDLAND_C2},
+    {"wendland_c4", RHOD_KERNEL_WENDLAND_C4},
+    {"quintic", RHOD_KERNEL_QUINTIC},
+};
+static const cyaml_strval_t init_names[] = {
+    {"uniform", RHOD_INIT_UNIFORM},
+    {"hydrostatic", RHOD_INIT_HYDROSTATIC},
+};
+static const cyaml_strval_t slip_names[] = {
+    {"free", RHOD_SLIP_FREE},
+    {"no", RHOD_SLIP_NO},
+};
+static const cyaml_strval_t field_names[] = {
+    {"pressure", RHOD_FIELD_PRESSURE}, {"velocity", RHOD_FIELD_VELOCITY},
+    {"density", RHOD_FIELD_DENSITY},   {"size", RHOD_FIELD_SIZE},
+    {"free_surface", RHOD_FIELD_FREE_SURFACE},
+};
+static const char *const probe_kind_names[] = {
+    "pressure", "kinetic_energy", "potential_energy", "front",
+    "mass",     "momentum",       "angular_momentum",
+};
+
+static const cyaml_schema_field_t f_time[] = {
+    NUM("end", y_time, end),
+    NUM("output_every", y_time, output_every),
+    NUM_OPT("cfl", y_time, cfl),
+    NUM_OPT("cfl_visc", y_time, cfl_visc),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_particles[] = {
+    NUM("dx", y_particles, dx),
+    NUM_OPT("radius_ratio", y_particles, radius_ratio),
+    ENUM_OPT("kernel", y_particles, kernel, kernel_names),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_physics[] = {
+    NUM_OPT("rho0", y_physics, rho0),
+    NUM("c0", y_physics, c0),
+    NUM_OPT("mu", y_physics, mu),
+    VEC("gravity", OPT, y_physics, gravity),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_scheme[] = {
+    BOOL_OPT("riemann", y_scheme, riemann),
+    BOOL_OPT("reconstruction", y_scheme, reconstruction),
+    BOOL_OPT("shifting", y_scheme, shifting),
+    NUM_OPT("shifting_a", y_scheme, shifting_a),
+    NUM_OPT("shifting_b", y_scheme, shifting_b),
+    NUM_OPT("shifting_eps", y_scheme, shifting_eps),
+    BOOL_OPT("acoustic_damper", y_scheme, acoustic_damper),
+    NUM_OPT("alpha_ad", y_scheme, alpha_ad),
+    BOOL_OPT("free_surface", y_scheme, free_surface),
+    VEC("free_surface_lambda", OPT, y_scheme, free_surface_lambda),
+    NUM_OPT("shepard_threshold", y_scheme, shepard_threshold),
+    NUM_OPT("theta_threshold", y_scheme, theta_threshold),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_domain[] = {
+    VEC("min", OPT, y_domain, min),
+    VEC("max", OPT, y_domain, max),
+    CYAML_FIELD_SEQUENCE_FIXED("periodic", OPT | CYAML_FLAG_FLOW, y_domain, periodic, &sch_bool,
+                               2),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_rect[] = {
+    VEC("min", 0, y_rect, min),
+    VEC("max", 0, y_rect, max),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_circle[] = {
+    VEC("center", 0, y_circle, center),
+    NUM("radius", y_circle, radius),
+    CYAML_FIELD_END,
+};
+
+#define SHAPE_FIELDS(st)                                                                         \
+  CYAML_FIELD_MAPPING_PTR("rect", OPT | CYAML_FLAG_FLOW, st, rect, f_rect),                      \
+      CYAML_FIELD_MAPPING_PTR("circle", OPT | CYAML_FLAG_FLOW, st, circle, f_circle),            \
+      CYAML_FIELD_SEQUENCE_COUNT("polygon", OPT | CYAML_FLAG_FLOW, st, polygon, n_polygon,       \
+                                 &sch_vec, 3, CYAML_UNLIMITED)
+
+static const cyaml_schema_field_t f_fluid[] = {
+    SHAPE_FIELDS(y_fluid),
+    VEC("velocity", OPT, y_fluid, velocity),
+    ENUM_OPT("pressure", y_fluid, pressure, init_names),
+    CYAML_FIELD_END,
+};
+static const cyaml_schema_value_t sch_fluid = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, y_fluid, f_fluid)};
+
+static const cyaml_schema_field_t f_wall[] = {
+    SHAPE_FIELDS(y_wall),
+    ENUM_OPT("slip", y_wall, slip, slip_names),
+    BOOL_OPT("fluid_inside", y_wall, fluid_inside),
+    CYAML_FIELD_END,
+};
+static const cyaml_schema_value_t sch_wall = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, y_wall, f_wall)};
+
+static const cyaml_schema_field_t f_probe_point[] = {
+    NAME_OPT(y_probe_point),
+    VEC("at", 0, y_probe_point, at),
+    CYAML_FIELD_END,
+};
+static const cyaml_schema_field_t f_probe_sum[] = {
+    NAME_OPT(y_probe_sum),
+    CYAML_FIELD_END,
+};
+static const cyaml_schema_field_t f_probe_front[] = {
+    NAME_OPT(y_probe_front),
+    VEC("direction", OPT, y_probe_front, direction),
+    CYAML_FIELD_END,
+};
+static const cyaml_schema_field_t f_probe_angular[] = {
+    NAME_OPT(y_probe_angular),
+    VEC("at", OPT, y_probe_angular, at),
+    CYAML_FIELD_END,
+};
+
+#define PROBE(key, member, fields)                                                               \
+  CYAML_FIELD_MAPPING_PTR(key, OPT | CYAML_FLAG_FLOW, y_probe, member, fields)
+static const cyaml_schema_field_t f_probe[] = {
+    PROBE("pressure", pressure, f_probe_point),
+    PROBE("kinetic_energy", kinetic_energy, f_probe_sum),
+    PROBE("potential_energy", potential_energy, f_probe_sum),
+    PROBE("front", front, f_probe_front),
+    PROBE("mass", mass, f_probe_sum),
+    PROBE("momentum", momentum, f_probe_sum),
+    PROBE("angular_momentum", angular_momentum, f_probe_angular),
+    CYAML_FIELD_END,
+};
+static const cyaml_schema_value_t sch_probe = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, y_probe, f_probe)};
+
+static const cyaml_schema_field_t f_probes[] = {
+    NUM_OPT("every", y_probes, every),
+    CYAML_FIELD_SEQUENCE_COUNT("list", OPT, y_probes, list, n_list, &sch_probe, 0,
+                               CYAML_UNLIMITED),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_picture[] = {
+    ENUM_OPT("field", y_picture, field, field_names),
+    NUM_OPT("width", y_picture, width),
+    VEC("range", OPT, y_picture, range),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_output[] = {
+    CYAML_FIELD_MAPPING_PTR("picture", OPT, y_output, picture, f_picture),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_doc[] = {
+    CYAML_FIELD_STRING_PTR("name", OPT, y_doc, name, 1, NAME_MAX_LEN),
+    CYAML_FIELD_MAPPING("time", CYAML_FLAG_DEFAULT, y_doc, time, f_time),
+    CYAML_FIELD_MAPPING("particles", CYAML_FLAG_DEFAULT, y_doc, particles, f_particles),
+    CYAML_FIELD_MAPPING("physics", CYAML_FLAG_DEFAULT, y_doc, physics, f_physics),
+    CYAML_FIELD_MAPPING_PTR("scheme", OPT, y_doc, scheme, f_scheme),
+    CYAML_FIELD_MAPPING_PTR("domain", OPT, y_doc, domain, f_domain),
+    CYAML_FIELD_SEQUENCE_COUNT("fluid", CYAML_FLAG_POINTER, y_doc, fluid, n_fluid, &sch_fluid, 1,
+                               CYAML_UNLIMITED),
+    CYAML_FIELD_SEQUENCE_COUNT("walls", OPT, y_doc, walls, n_walls, &sch_wall, 0,
+                               CYAML_UNLIMITED),
+    CYAML_FIELD_MAPPING_PTR("probes", OPT, y_doc, probes, f_probes),
+    CYAML_FIELD_MAPPING_PTR("output", OPT, y_doc, output, f_output),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_value_t sch_doc = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, y_doc, f_doc)};
+
+/* ---- loading context and messages ------------------------------------------------------ */
+
+typedef struct {
+  const char *file;
+  const char *const *ov;
+  int n_ov;
+  ry_node *root;
+  char *err;
+  size_t errlen;
+} lctx;
+
+static void put_msg(lctx *c, const char *fmt, ...) {
+  if (!c->err || !c->errlen) return;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(c->err, c->errlen, fmt, ap);
+  va_end(ap);
+}
+
+static const char *shown(const char *path) { return path && path[0] ? path : "(top level)"; }
+
+/* "FILE:LINE:COL: path: reason", or "--set K=V: path: reason" when node came from an
+ * override. Returns RHOD_ERR_SCENE. */
+static int vfail_at(lctx *c, const ry_node *n, const char *path, const char *fmt, va_list ap) {
+  char reason[768];
+  vsnprintf(reason, sizeof reason, fmt, ap);
+  if (n && n->origin >= 0 && n->origin < c->n_ov)
+    put_msg(c, "--set %s: %s: %s", c->ov[n->origin], shown(path), reason);
+  else
+    put_msg(c, "%s:%u:%u: %s: %s", c->file, n ? n->line : 1u, n ? n->col : 1u, shown(path),
+            reason);
+  return RHOD_ERR_SCENE;
+}
+
+static int fail_at(lctx *c, const ry_node *n, const char *path, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  int rc = vfail_at(c, n, path, fmt, ap);
+  va_end(ap);
+  return rc;
+}
+
+/* An error about the value at a dotted path: located at the deepest node of the path that
+ * the document holds (the value itself, or where it would go). */
+static int fail(lctx *c, const char *path, const char *fmt, ...) {
+  const ry_node *n = ry_find_path(c->root, path);
+  va_list ap;
+  va_start(ap, fmt);
+  int rc = vfail_at(c, n, path, fmt, ap);
+  va_end(ap);
+  return rc;
+}
+
+static int fail_ov(lctx *c, int k, const char *path, const char *fmt, ...) {
+  char reason[768];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(reason, sizeof reason, fmt, ap);
+  va_end(ap);
+  put_msg(c, "--set %s: %s: %s", c->ov[k], shown(path), reason);
+  return RHOD_ERR_SCENE;
+}
+
+static int fail_oom(lctx *c) {
+  put_msg(c, "%s: out of memory", c->file);
+  return RHOD_ERR_MEMORY;
+}
+
+static void node_path(const ry_node *n, char *buf, size_t len) { ry_path(n, buf, len); }
+
+/* ---- schema helpers -------------------------------------------------------------------- */
+
+static int is_seq_schema(const cyaml_schema_value_t *s) {
+  return s && (s->type == CYAML_SEQUENCE || s->type == CYAML_SEQUENCE_FIXED);
+}
+
+static const cyaml_schema_field_t *schema_field(const cyaml_schema_value_t *s, const char *key) {
+  if (!s || s->type != CYAML_MAPPING) return NULL;
+  for (const cyaml_schema_field_t *f = s->mapping.fields; f->key; f++)
+    if (strcmp(f->key, key) == 0) return f;
+  return NULL;
+}
+
+static void annotate(ry_node *n, const cyaml_schema_value_t *s) {
+  n->schema = s;
+  for (unsigned i = 0; i < n->n; i++) {
+    const cyaml_schema_value_t *child = NULL;
+    if (n->kind == RY_MAP) {
+      const cyaml_schema_field_t *f = schema_field(s, n->keys[i]->text);
+      child = f ? &f->value : NULL;
+    } else if (is_seq_schema(s)) {
+      child = s->sequence.entry;
+    }
+    annotate(n->items[i], child);
+  }
+}
+
+static void describe_schema(const cyaml_schema_value_t *s, char *buf, size_t len) {
+  if (!s) {
+    snprintf(buf, len, "nothing");
+    return;
+  }
+  switch (s->type) {
+  case CYAML_MAPPING:
+    snprintf(buf, len, "a mapping");
+    break;
+  case CYAML_SEQUENCE_FIXED:
+    snprintf(buf, len, "a list of %u %s", (unsigned)s->sequence.max,
+             s->sequence.entry->type == CYAML_BOOL ? "booleans" : "numbers");
+    break;
+  case CYAML_SEQUENCE:
+    snprintf(buf, len, "a list");
+    break;
+  case CYAML_FLOAT:
+    snprintf(buf, len, "a number");
+    break;
+  case CYAML_INT:
+  case CYAML_UINT:
+    snprintf(buf, len, "an integer");
+    break;
+  case CYAML_BOOL:
+    snprintf(buf, len, "true or false");
+    break;
+  case CYAML_STRING:
+    snprintf(buf, len, "a string");
+    break;
+  case CYAML_ENUM: {
+    size_t used = (size_t)snprintf(buf, len, "one of");
+    for (uint32_t i = 0; i < s->enumeration.count && used < len; i++)
+      used += (size_t)snprintf(buf + used, len - used, "%s %s", i ? "," : ":",
+                               s->enumeration.strings[i].str);
+    break;
+  }
+  default:
+    snprintf(buf, len, "another type");
+    break;
+  }
+}
+
+static void describe_node(const ry_node *n, char *buf, size_t len) {
+  if (n->kind == RY_SCALAR)
+    snprintf(buf, len, "'%s'", n->text);
+  else
+    snprintf(buf, len, "%s", n->kind == RY_MAP ? "a mapping" : "a list");
+}
+
+/* ---- libcyaml's report ----------------------------------------------------------------- */
+
+typedef struct {
+  char text[4096];
+  size_t len;
+} cy_log;
+
+static void cy_log_fn(cyaml_log_t level, void *ctx, const char *fmt, va_list args) {
+  cy_log *l = ctx;
+  if (level < CYAML_LOG_ERROR || l->len + 1 >= sizeof l->text) return;
+  int n = vsnprintf(l->text + l->len, sizeof l->text - l->len, fmt, args);
+  if (n > 0) l->len += (size_t)n < sizeof l->text - l->len ? (size_t)n : sizeof l->text - l->len - 1;
+}
+
+static ry_node *find_unknown_key(ry_node *n, const char *key) {
+  if (n->kind == RY_MAP && n->schema && ((const cyaml_schema_value_t *)n->schema)->type == CYAML_MAPPING) {
+    ry_node *k = ry_map_key(n, key);
+    if (k && !schema_field(n->schema, key)) return k;
+  }
+  for (unsigned i = 0; i < n->n; i++) {
+    ry_node *k = find_unknown_key(n->items[i], key);
+    if (k) return k;
+  }
+  return NULL;
+}
+
+static int lacks_required(const ry_node *m, const char *key) {
+  const cyaml_schema_field_t *f = m->kind == RY_MAP ? schema_field(m->schema, key) : NULL;
+  return f && !(f->value.flags & CYAML_FLAG_OPTIONAL) && !ry_map_key(m, key);
+}
+
+static ry_node *find_missing(ry_node *n, const char *key) {
+  for (unsigned i = 0; i < n->n; i++) {
+    ry_node *m = find_missing(n->items[i], key);
+    if (m) return m;
+  }
+  return lacks_required(n, key) ? n : NULL;
+}
+
+static int count_bad(const ry_node *n) {
+  const cyaml_schema_value_t *s = n->schema;
+  return n->kind == RY_SEQ && is_seq_schema(s) && (n->n < s->sequence.min || n->n > s->sequence.max);
+}
+
+static ry_node *find_bad_count(ry_node *n) {
+  if (count_bad(n)) return n;
+  for (unsigned i = 0; i < n->n; i++) {
+    ry_node *m = find_bad_count(n->items[i]);
+    if (m) return m;
+  }
+  return NULL;
+}
+
+/* Builds the user's message from libcyaml's log: the reason from its first line, the place
+ * from the innermost "(line: L, column: C)" of its backtrace. */
+static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
+  if (cerr == CYAML_ERR_OOM) return fail_oom(c);
+  char reason[512] = "";
+  unsigned line = 0, col = 0;
+  for (const char *p = log->text; *p;) {
+    const char *eol = strchr(p, '\n');
+    size_t n = eol ? (size_t)(eol - p) : strlen(p);
+    const char *mk = memchr(p, '(', n);
+    if (!reason[0] && strncmp(p, "Load: ", 6) == 0 && strncmp(p, "Load: Backtrace:", 16) != 0)
+      snprintf(reason, sizeof reason, "%.*s", (int)(n - 6), p + 6);
+    else if (!line && mk && sscanf(mk, "(line: %u, column: %u)", &line, &col) != 2)
+      line = col = 0;
+    p += n + (eol ? 1 : 0);
+  }
+  size_t rl = strlen(reason);
+  while (rl && (reason[rl - 1] == '.' || reason[rl - 1] == ' ')) reason[--rl] = '\0';
+  if (!reason[0]) snprintf(reason, sizeof reason, "%s", cyaml_strerror(cerr));
+
+  ry_node *at = line ? ry_find_emitted(c->root, line, col) : c->root;
+  char path[256], want[600], got[256];
+  node_path(at, path, sizeof path);
+  const char *arg = strstr(reason, ": ");
+  arg = arg ? arg + 2 : "";
+
+  if (strncmp(reason, "Unexpected key: ", 16) == 0) {
+    ry_node *k = NULL;
+    for (ry_node *m = at->is_key ? at->parent : at; m && !k; m = m->parent) {
+      ry_node *cand = m->kind == RY_MAP ? ry_map_key(m, arg) : NULL;
+      if (cand && !schema_field(m->schema, arg)) k = cand;
+    }
+    if (!k) k = find_unknown_key(c->root, arg);
+    if (!k) return fail_at(c, at, path, "unknown key '%s'", arg);
+    node_path(k, path, sizeof path);
+    return fail_at(c, k, path, "unknown key");
+  }
+  if (strncmp(reason, "Missing required mapping field: ", 32) == 0) {
+    ry_node *m = at->is_key ? at->parent : at;
+    while (m && !lacks_required(m, arg)) m = m->parent;
+    if (!m) m = find_missing(c->root, arg);
+    if (!m) return fail_at(c, at, path, "missing required key '%s'", arg);
+    node_path(m, path, sizeof path);
+    snprintf(want, sizeof want, "%s%s%s", path, path[0] ? "." : "", arg);
+    /* a block mapping starts at its first key: point at the key that names it instead */
+    const ry_node *where = m->parent && m->parent->kind == RY_MAP ? m->parent->keys[m->index] : m;
+    return fail_at(c, where, want, "missing required key");
+  }
+  if (strncmp(reason, "Insufficient entries", 20) == 0 ||
+      strncmp(reason, "Excessive entries", 17) == 0) {
+    ry_node *s = at;
+    while (s && !count_bad(s)) s = s->parent;
+    if (!s) s = find_bad_count(c->root);
+    if (!s) return fail_at(c, at, path, "%s", reason);
+    const cyaml_schema_value_t *sch = s->schema;
+    node_path(s, path, sizeof path);
+    if (sch->type == CYAML_SEQUENCE_FIXED)
+      return fail_at(c, s, path, "expected %u entries, got %u", (unsigned)sch->sequence.min, s->n);
+    if (s->n < sch->sequence.min)
+      return fail_at(c, s, path, "expected at least %u entr%s, got %u",
+                     (unsigned)sch->sequence.min, sch->sequence.min == 1 ? "y" : "ies", s->n);
+    return fail_at(c, s, path, "expected at most %u entries, got %u", (unsigned)sch->sequence.max,
+                   s->n);
+  }
+  if (at->is_key) { /* value errors name the value, never a key */
+    at = at->parent->items[at->index];
+    node_path(at, path, sizeof path);
+  }
+  const cyaml_schema_value_t *sch = at->schema;
+  describe_schema(sch, want, sizeof want);
+  describe_node(at, got, sizeof got);
+  if (strncmp(reason, "Expecting ", 10) == 0) return fail_at(c, at, path, "expected %s, got %s", want, got);
+  const char *text = at->kind == RY_SCALAR ? at->text : arg;
+  if (strncmp(reason, "Invalid FLOAT", 13) == 0) return fail_at(c, at, path, "invalid number '%s'", text);
+  if (strncmp(reason, "FLOAT", 5) == 0) return fail_at(c, at, path, "number out of range '%s'", text);
+  if (strncmp(reason, "Invalid BOOL", 12) == 0)
+    return fail_at(c, at, path, "invalid boolean '%s' (true or false)", text);
+  if (strncmp(reason, "Invalid ENUM", 12) == 0)
+    return fail_at(c, at, path, "invalid value '%s' (%s)", text, want);
+  if (strncmp(reason, "Invalid INT", 11) == 0 || strncmp(reason, "Invalid UINT", 12) == 0)
+    return fail_at(c, at, path, "invalid integer '%s'", text);
+  if (strncmp(reason, "STRING length <", 15) == 0) return fail_at(c, at, path, "must not be empty");
+  if (strncmp(reason, "STRING length >", 15) == 0)
+    return fail_at(c, at, path, "longer than %d characters", NAME_MAX_LEN);
+  return fail_at(c, at, path, "%s", reason);
+}
+
+/* ---- strict scalars: libcyaml reads "1.5x" as 1.5 and any word but false/no/off as true -- */
+
+static int parse_number(const char *s, double *v) {
+  if (!s[0] || strchr(" \t\n\r\f\v", s[0])) return 0;
+  char *end;
+  errno = 0;
+  *v = strtod(s, &end);
+  return *end == '\0';
+}
+
+static int parse_bool(const char *s, bool *v) {
+  static const char *const yes[] = {"true", "yes", "on"}, *const no[] = {"false", "no", "off"};
+  for (int i = 0; i < 3; i++) {
+    if (strcasecmp(s, yes[i]) == 0) return *v = true, 1;
+    if (strcasecmp(s, no[i]) == 0) return *v = false, 1;
+  }
+  return 0;
+}
+
+static int check_scalars(lctx *c, const ry_node *n) {
+  const cyaml_schema_value_t *s = n->schema;
+  if (n->kind == RY_SCALAR && s) {
+    char path[256];
+    double v;
+    bool b;
+    if (s->type == CYAML_FLOAT) {
+      if (!parse_number(n->text, &v)) {
+        node_path(n, path, sizeof path);
+        return fail_at(c, n, path, "invalid number '%s'", n->text);
+      }
+      if (!isfinite(v)) {
+        node_path(n, path, sizeof path);
+        return fail_at(c, n, path, "must be a finite number, got '%s'", n->text);
+      }
+    } else if (s->type == CYAML_BOOL && !parse_bool(n->text, &b)) {
+      node_path(n, path, sizeof path);
+      return fail_at(c, n, path, "invalid boolean '%s' (true or false)", n->text);
+    }
+  }
+  for (unsigned i = 0; i < n->n; i++) {
+    int rc = check_scalars(c, n->items[i]);
+    if (rc) return rc;
+  }
+  return RHOD_OK;
+}
+
+/* ---- `--set` overrides ------------------------------------------------------------------ */
+
+static int apply_override(lctx *c, int k) {
+  const char *ov = c->ov[k] ? c->ov[k] : "";
+  const char *eq = strchr(ov, '=');
+  if (!eq || eq == ov) return fail_ov(c, k, "", "expected dotted.key=value");
+  size_t klen = (size_t)(eq - ov);
+  char key[256];
+  if (klen >= sizeof key) return fail_ov(c, k, "", "key longer than %zu characters", sizeof key - 1);
+  memcpy(key, ov, klen);
+  key[klen] = '\0';
+  const char *text = eq + 1;
+
+  ry_node *val = NULL;
+  ry_error ye;
+  if (ry_parse(text, strlen(text), k, &val, &ye)) {
+    if (ye.oom) return fail_oom(c);
+    return fail_ov(c, k, key, "invalid YAML value: %s", ye.msg);
+  }
+  if (!val && !(val = ry_new_scalar("", k, 1, 1))) return fail_oom(c);
+
+  const cyaml_schema_value_t *s = &sch_doc;
+  ry_node *cur = c->root;
+  char path[600] = "";
+  int rc = RHOD_OK;
+  for (char *seg = key, *next; seg; seg = next) {
+    next = strchr(seg, '.');
+    if (next) *next++ = '\0';
+    size_t used = strlen(path);
+    snprintf(path + used, sizeof path - used, "%s%s", used ? "." : "", seg);
+    if (!seg[0]) {
+      rc = fail_ov(c, k, path, "empty key");
+      break;
+    }
+    const cyaml_schema_value_t *child_schema;
+    ry_node *child;
+    char got[256];
+    if (s->type == CYAML_MAPPING) {
+      const cyaml_schema_field_t *f = schema_field(s, seg);
+      if (!f) {
+        rc = fail_ov(c, k, path, "unknown key");
+        break;
+      }
+      if (cur->kind != RY_MAP) {
+        char parent[256];
+        node_path(cur, parent, sizeof parent);
+        describe_node(cur, got, sizeof got);
+        rc = fail_at(c, cur, parent, "expected a mapping, got %s", got);
+        break;
+      }
+      child_schema = &f->value;
+      if (!next) {
+        if (ry_map_set(cur, seg, val)) rc = fail_oom(c);
+        val = NULL;
+        break;
+      }
+      child = ry_map_get(cur, seg);
+      if (!child && (child_schema->type == CYAML_MAPPING || is_seq_schema(child_schema))) {
+        child = ry_new(child_schema->type == CYAML_MAPPING ? RY_MAP : RY_SEQ, k, cur->line, cur->col);
+        if (!child || ry_map_set(cur, seg, child)) {
+          ry_free(child);
+          rc = fail_oom(c);
+          break;
+        }
+      }
+    } else if (is_seq_schema(s)) {
+      if (!seg[0] || strspn(seg, "0123456789") != strlen(seg) || strlen(seg) > 6) {
+        rc = fail_ov(c, k, path, "expected a list index, got '%s'", seg);
+        break;
+      }
+      unsigned idx = (unsigned)strtoul(seg, NULL, 10);
+      if (cur->kind != RY_SEQ) {
+        char parent[256];
+        node_path(cur, parent, sizeof parent);
+        describe_node(cur, got, sizeof got);
+        rc = fail_at(c, cur, parent, "expected a list, got %s", got);
+        break;
+      }
+      child_schema = s->sequence.entry;
+      int append = idx == cur->n && s->type == CYAML_SEQUENCE;
+      if (idx > cur->n || (idx == cur->n && !append)) {
+        rc = fail_ov(c, k, path, "index %u out of range (the list has %u entr%s)", idx, cur->n,
+                     cur->n == 1 ? "y" : "ies");
+        break;
+      }
+      if (!next) {
+        if (append) {
+          if (ry_seq_append(cur, val)) {
+            rc = fail_oom(c);
+            break;
+          }
+        } else {
+          ry_replace(cur->items[idx], val);
+        }
+        val = NULL;
+        break;
+      }
+      child = append ? NULL : cur->items[idx];
+      if (!child && (child_schema->type == CYAML_MAPPING || is_seq_schema(child_schema))) {
+        child = ry_new(child_schema->type == CYAML_MAPPING ? RY_MAP : RY_SEQ, k, cur->line, cur->col);
+        if (!child || ry_seq_append(cur, child)) {
+          ry_free(child);
+          rc = fail_oom(c);
+          break;
+        }
+      }
+    } else {
+      rc = fail_ov(c, k, path, "unknown key");
+      break;
+    }
+    if (!child) { /* a scalar in the schema: the next segment cannot exist */
+      size_t u = strlen(path);
+      snprintf(path + u, sizeof path - u, ".%s", next);
+      rc = fail_ov(c, k, path, "unknown key");
+      break;
+    }
+    s = child_schema;
+    cur = child;
+  }
+  ry_free(val);
+  return rc;
+}
+
+/* ---- value checks and defaults ---------------------------------------------------------- */
+
+static int check_positive(lctx *c, const char *path, double v) {
+  return v > 0 ? RHOD_OK : fail(c, path, "must be > 0, got %g", v);
+}
+
+static int check_range(lctx *c, const char *path, double v, double lo, int lo_open, double hi,
+                       int hi_open) {
+  int ok = (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  if (ok) return RHOD_OK;
+  return fail(c, path, "must be in %s%g, %g%s, got %g", lo_open ? "(" : "[", lo, hi,
+              hi_open ? ")" : "]", v);
+}
+
+#define TRY(expr)                                                                                \
+  do {                                                                                           \
+    int rc_ = (expr);                                                                            \
+    if (rc_) return rc_;                                                                         \
+  } while (0)
+
+static double opt(const double *p, double def) { return p ? *p : def; }
+static int opt_bool(const bool *p, int def) { return p ? (*p ? 1 : 0) : def; }
+
+static double polygon_area(const double (*p)[2], unsigned n) {
+  double a = 0;
+  for (unsigned i = 0; i < n; i++) {
+    const double *u = p[i], *v = p[(i + 1) % n];
+    a += u[0] * v[1] - v[0] * u[1];
+  }
+  return 0.5 * a;
+}
+
+static double orient(const double *a, const double *b, const double *p) {
+  return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+}
+
+static int on_segment(const double *a, const double *b, const double *p) {
+  return fmin(a[0], b[0]) <= p[0] && p[0] <= fmax(a[0], b[0]) && fmin(a[1], b[1]) <= p[1] &&
+         p[1] <= fmax(a[1], b[1]);
+}
+
+static int segments_meet(const double *a, const double *b, const double *p, const double *q) {
+  double d1 = orient(p, q, a), d2 = orient(p, q, b), d3 = orient(a, b, p), d4 = orient(a, b, q);
+  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
+    return 1;
+  return (d1 == 0 && on_segment(p, q, a)) || (d2 == 0 && on_segment(p, q, b)) ||
+         (d3 == 0 && on_segment(a, b, p)) || (d4 == 0 && on_segment(a, b, q));
+}
+
+static void shape_bbox(const rhod_shape *sh, double lo[2], double hi[2]) {
+  for (int d = 0; d < 2; d++) {
+    switch (sh->kind) {
+    case RHOD_SHAPE_RECT:
+      lo[d] = sh->min[d];
+      hi[d] = sh->max[d];
+      break;
+    case RHOD_SHAPE_CIRCLE:
+      lo[d] = sh->center[d] - sh->radius;
+      hi[d] = sh->center[d] + sh->radius;
+      break;
+    case RHOD_SHAPE_POLYGON:
+      lo[d] = hi[d] = sh->points[0][d];
+      for (unsigned i = 1; i < sh->n_points; i++) {
+        lo[d] = fmin(lo[d], sh->points[i][d]);
+        hi[d] = fmax(hi[d], sh->points[i][d]);
+      }
+      break;
+    }
+  }
+}
+
+static double shape_area(const rhod_shape *sh) {
+  switch (sh->kind) {
+  case RHOD_SHAPE_RECT:
+    return (sh->max[0] - sh->min[0]) * (sh->max[1] - sh->min[1]);
+  case RHOD_SHAPE_CIRCLE:
+    return M_PI * sh->radius * sh->radius;
+  case RHOD_SHAPE_POLYGON:
+    return fabs(polygon_area((const double(*)[2])sh->points, sh->n_points));
+  }
+  return 0;
+}
+
+/* One of rect / circle / polygon, checked and copied into out (polygons counter-clockwise). */
+static int load_shape(lctx *c, const char *base, const y_rect *rect, const y_circle *circle,
+                      double (*poly)[2], unsigned np, rhod_shape *out) {
+  char path[128];
+  const char *given[3];
+  int n = 0;
+  if (rect) given[n++] = "rect";
+  if (circle) given[n++] = "circle";
+  if (poly) given[n++] = "polygon";
+  if (n == 0) return fail(c, base, "needs a shape: one of rect, circle, polygon");
+  if (n > 1) {
+    snprintf(path, sizeof path, "%s.%s", base, given[1]);
+    return fail(c, path, "one shape per entry, but %s is also given", given[0]);
+  }
+  if (rect) {
+    out->kind = RHOD_SHAPE_RECT;
+    memcpy(out->min, rect->min, sizeof out->min);
+    memcpy(out->max, rect->max, sizeof out->max);
+    if (!(rect->min[0] < rect->max[0] && rect->min[1] < rect->max[1])) {
+      snprintf(path, sizeof path, "%s.rect.max", base);
+      return fail(c, path, "must exceed rect.min in both axes (min [%g, %g], max [%g, %g])",
+                  rect->min[0], rect->min[1], rect->max[0], rect->max[1]);
+    }
+  } else if (circle) {
+    out->kind = RHOD_SHAPE_CIRCLE;
+    memcpy(out->center, circle->center, sizeof out->center);
+    out->radius = circle->radius;
+    snprintf(path, sizeof path, "%s.circle.radius", base);
+    TRY(check_positive(c, path, circle->radius));
+  } else {
+    out->kind = RHOD_SHAPE_POLYGON;
+    snprintf(path, sizeof path, "%s.polygon", base);
+    for (unsigned i = 0; i < np; i++) {
+      const double *a = poly[i], *b = poly[(i + 1) % np];
+      if (a[0] == b[0] && a[1] == b[1])
+        return fail(c, path, "points %u and %u coincide", i, (i + 1) % np);
+    }
+    for (unsigned i = 0; i < np; i++)
+      for (unsigned j = i + 2; j < np; j++) {
+        if (i == 0 && j == np - 1) continue; /* adjacent through the closing edge */
+        if (segments_meet(poly[i], poly[i + 1], poly[j], poly[(j + 1) % np]))
+          return fail(c, path, "edges %u-%u and %u-%u cross: the polygon must be simple", i, i + 1,
+                      j, (j + 1) % np);
+      }
+    double area = polygon_area((const double(*)[2])poly, np);
+    if (area == 0) return fail(c, path, "has zero area");
+    out->points = malloc(np * sizeof *out->points);
+    if (!out->points) return fail_oom(c);
+    out->n_points = np;
+    for (unsigned i = 0; i < np; i++) { /* counter-clockwise */
+      const double *src = area > 0 ? poly[i] : poly[np - 1 - i];
+      out->points[i][0] = src[0];
+      out->points[i][1] = src[1];
+    }
+  }
+  return RHOD_OK;
+}
+
+static int valid_name(const char *s) {
+  if (!s[0] || s[0] == '.' || strlen(s) > NAME_MAX_LEN) return 0;
+  return strspn(s, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") ==
+         strlen(s);
+}
+
+/* Default scene name: the file's base name without extension, or the name of its folder
+ * when the file is called scene.*; characters outside [A-Za-z0-9_.-] become '_'. */
+static char *default_name(const char *file) {
+  const char *base = strrchr(file, '/');
+  base = base ? base + 1 : file;
+  size_t len = strcspn(base, ".");
+  const char *start = base;
+  if (len == 5 && strncmp(base, "scene", 5) == 0 && base != file) {
+    const char *end = base - 1; /* the '/' */
+    const char *dir = end;
+    while (dir > file && dir[-1] != '/') dir--;
+    if (end > dir && !(end - dir == 1 && dir[0] == '.') && !(end - dir == 2 && dir[0] == '.')) {
+      start = dir;
+      len = (size_t)(end - dir);
+    }
+  }
+  if (len == 0) {
+    start = "scene";
+    len = 5;
+  }
+  if (len > NAME_MAX_LEN) len = NAME_MAX_LEN;
+  char *name = malloc(len + 1);
+  if (!name) return NULL;
+  for (size_t i = 0; i < len; i++)
+    name[i] = strchr("_.-", start[i]) || (start[i] >= '0' && start[i] <= '9') ||
+                      (start[i] >= 'a' && start[i] <= 'z') || (start[i] >= 'A' && start[i] <= 'Z')
+                  ? start[i]
+                  : '_';
+  name[len] = '\0';
+  if (name[0] == '.') name[0] = '_';
+  return name;
+}
+
+static int inside_box(const double lo[2], const double hi[2], const double bmin[2],
+                      const double bmax[2]) {
+  for (int d = 0; d < 2; d++) {
+    double tol = 1e-9 * fmax(1.0, bmax[d] - bmin[d]);
+    if (lo[d] < bmin[d] - tol || hi[d] > bmax[d] + tol) return 0;
+  }
+  return 1;
+}
+
+static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char *kind_path,
+                      size_t kpl) {
+  char base[64];
+  snprintf(base, sizeof base, "probes.list.%u", i);
+  const void *given[7] = {y->pressure,         y->kinetic_energy, y->potential_energy, y->front,
+                          y->mass,             y->momentum,       y->angular_momentum};
+  int first = -1;
+  for (int k = 0; k < 7; k++) {
+    if (!given[k]) continue;
+    if (first >= 0) {
+      char path[128];
+      snprintf(path, sizeof path, "%s.%s", base, probe_kind_names[k]);
+      return fail(c, path, "one probe per entry, but %s is also given", probe_kind_names[first]);
+    }
+    first = k;
+  }
+  if (first < 0) {
+    char kinds[256] = "";
+    for (int k = 0; k < 7; k++)
+      snprintf(kinds + strlen(kinds), sizeof kinds - strlen(kinds), "%s%s", k ? ", " : "",
+               probe_kind_names[k]);
+    return fail(c, base, "needs a probe kind: one of %s", kinds);
+  }
+  p->kind = (rhod_probe_kind)first;
+  snprintf(kind_path, kpl, "%s.%s", base, probe_kind_names[first]);
+  const char *name = NULL;
+  switch (p->kind) {
+  case RHOD_PROBE_PRESSURE:
+    name = y->pressure->name;
+    memcpy(p->at, y->pressure->at, sizeof p->at);
+    break;
+  case RHOD_PROBE_KINETIC_ENERGY:
+    name = y->kinetic_energy->name;
+    break;
+  case RHOD_PROBE_POTENTIAL_ENERGY:
+    name = y->potential_energy->name;
+    break;
+  case RHOD_PROBE_FRONT: {
+    name = y->front->name;
+    double dir[2] = {1, 0};
+    if (y->front->direction) memcpy(dir, y->front->direction, sizeof dir);
+    double len = hypot(dir[0], dir[1]);
+    if (!(len > 0)) {
+      char path[128];
+      snprintf(path, sizeof path, "%s.direction", kind_path);
+      return fail(c, path, "must not be zero");
+    }
+    p->direction[0] = dir[0] / len;
+    p->direction[1] = dir[1] / len;
+    break;
+  }
+  case RHOD_PROBE_MASS:
+    name = y->mass->name;
+    break;
+  case RHOD_PROBE_MOMENTUM:
+    name = y->momentum->name;
+    break;
+  case RHOD_PROBE_ANGULAR_MOMENTUM:
+    name = y->angular_momentum->name;
+    if (y->angular_momentum->at) memcpy(p->at, y->angular_momentum->at, sizeof p->at);
+    break;
+  }
+  if (!name) name = probe_kind_names[first];
+  if (!valid_name(name)) {
+    char path[160];
+    snprintf(path, sizeof path, "%s.name", kind_path);
+    return fail(c, path, "'%s' is not a valid name (letters, digits, '_', '.', '-')", name);
+  }
+  p->name = strdup(name);
+  return p->name ? RHOD_OK : fail_oom(c);
+}
+
+/* CSV column names of a probe: momentum has two. */
+static unsigned probe_columns(const rhod_probe *p, char cols[2][NAME_MAX_LEN + 3]) {
+  if (p->kind == RHOD_PROBE_MOMENTUM) {
+    snprintf(cols[0], sizeof cols[0], "%s_x", p->name);
+    snprintf(cols[1], sizeof cols[1], "%s_y", p->name);
+    return 2;
+  }
+  snprintf(cols[0], sizeof cols[0], "%s", p->name);
+  return 1;
+}
+
+static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
+  char path[128];
+  /* time */
+  s->t_end = d->time.end;
+  s->output_every = d->time.output_every;
+  s->cfl = opt(d->time.cfl, 0.5);
+  s->cfl_visc = opt(d->time.cfl_visc, 0.025);
+  TRY(check_positive(c, "time.end", s->t_end));
+  TRY(check_positive(c, "time.output_every", s->output_every));
+  TRY(check_range(c, "time.cfl", s->cfl, 0, 1, 1, 0));
+  TRY(check_positive(c, "time.cfl_visc", s->cfl_visc));
+  /* particles */
+  s->dx = d->particles.dx;
+  s->radius_ratio = opt(d->particles.radius_ratio, 4);
+  s->kernel = d->particles.kernel ? (rhod_kernel_kind)*d->particles.kernel : RHOD_KERNEL_WENDLAND_C2;
+  TRY(check_positive(c, "particles.dx", s->dx));
+  TRY(check_range(c, "particles.radius_ratio", s->radius_ratio, 2, 0, 8, 0));
+  /* physics */
+  s->rho0 = opt(d->physics.rho0, 1000);
+  s->c0 = d->physics.c0;
+  s->mu = opt(d->physics.mu, 0);
+  if (d->physics.gravity) memcpy(s->gravity, d->physics.gravity, sizeof s->gravity);
+  TRY(check_positive(c, "physics.rho0", s->rho0));
+  TRY(check_positive(c, "physics.c0", s->c0));
+  if (!(s->mu >= 0)) return fail(c, "physics.mu", "must be >= 0, got %g", s->mu);
+  /* scheme */
+  const y_scheme *sc = d->scheme;
+  static const y_scheme none = {0};
+  if (!sc) sc = &none;
+  s->riemann = opt_bool(sc->riemann, 1);
+  s->reconstruction = opt_bool(sc->reconstruction, 1);
+  s->shifting = opt_bool(sc->shifting, 1);
+  s->shift_a = opt(sc->shifting_a, 0.5);
+  s->shift_b = opt(sc->shifting_b, 0.05);
+  s->shift_eps = opt(sc->shifting_eps, 5e-4);
+  s->acoustic_damper = opt_bool(sc->acoustic_damper, 1);
+  s->alpha_ad = opt(sc->alpha_ad, 1);
+  s->free_surface = opt_bool(sc->free_surface, 1);
+  s->fs_lambda_low = sc->free_surface_lambda ? sc->free_surface_lambda[0] : 0.2;
+  s->fs_lambda_high = sc->free_surface_lambda ? sc->free_surface_lambda[1] : 0.75;
+  s->shepard_threshold = opt(sc->shepard_threshold, 0.85);
+  s->theta_threshold = opt(sc->theta_threshold, 0.95);
+  TRY(check_positive(c, "scheme.shifting_a", s->shift_a));
+  if (!(s->shift_b >= 0)) return fail(c, "scheme.shifting_b", "must be >= 0, got %g", s->shift_b);
+  TRY(check_positive(c, "scheme.shifting_eps", s->shift_eps));
+  TRY(check_positive(c, "scheme.alpha_ad", s->alpha_ad));
+  for (int i = 0; i < 2; i++) {
+    double v = i ? s->fs_lambda_high : s->fs_lambda_low;
+    if (!(v > 0 && v < 1.5))
+      return fail(c, "scheme.free_surface_lambda", "%s threshold must be in (0, 1.5), got %g",
+                  i ? "high" : "low", v);
+  }
+  if (!(s->fs_lambda_low < s->fs_lambda_high))
+    return fail(c, "scheme.free_surface_lambda", "low (%g) must be below high (%g)",
+                s->fs_lambda_low, s->fs_lambda_high);
+  TRY(check_range(c, "scheme.shepard_threshold", s->shepard_threshold, 0, 1, 1, 0));
+  TRY(check_range(c, "scheme.theta_threshold", s->theta_threshold, 0, 1, 1, 0));
+  /* domain */
+  const y_domain *dm = d->domain;
+  if (dm && (!dm->min) != (!dm->max))
+    return fail(c, dm->min ? "domain.min" : "domain.max",
+                "domain.min and domain.max are given together");
+  s->has_domain = dm && dm->min;
+  if (s->has_domain) {
+    memcpy(s->domain_min, dm->min, sizeof s->domain_min);
+    memcpy(s->domain_max, dm->max, sizeof s->domain_max);
+    if (!(s->domain_min[0] < s->domain_max[0] && s->domain_min[1] < s->domain_max[1]))
+      return fail(c, "domain.max", "must exceed domain.min in both axes");
+  }
+  if (dm && dm->periodic) {
+    s->periodic[0] = dm->periodic[0];
+    s->periodic[1] = dm->periodic[1];
+    if ((s->periodic[0] || s->periodic[1]) && !s->has_domain)
+      return fail(c, "domain.periodic", "a periodic axis needs domain.min and domain.max");
+  }
+  /* fluid */
+  s->fluid = calloc(d->n_fluid, sizeof *s->fluid);
+  if (!s->fluid) return fail_oom(c);
+  s->n_fluid = d->n_fluid;
+  for (unsigned i = 0; i < d->n_fluid; i++) {
+    const y_fluid *y = &d->fluid[i];
+    rhod_fluid_block *b = &s->fluid[i];
+    snprintf(path, sizeof path, "fluid.%u", i);
+    TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &b->shape));
+    if (y->velocity) memcpy(b->velocity, y->velocity, sizeof b->velocity);
+    b->pressure = y->pressure ? (rhod_init_kind)*y->pressure : RHOD_INIT_HYDROSTATIC;
+    double lo[2], hi[2];
+    shape_bbox(&b->shape, lo, hi);
+    if (s->has_domain && !inside_box(lo, hi, s->domain_min, s->domain_max))
+      return fail(c, path, "lies outside the domain [%g, %g]-[%g, %g] (block spans [%g, %g]-[%g, %g])",
+                  s->domain_min[0], s->domain_min[1], s->domain_max[0], s->domain_max[1], lo[0],
+                  lo[1], hi[0], hi[1]);
+    double area = shape_area(&b->shape), w = fmin(hi[0] - lo[0], hi[1] - lo[1]);
+    if (area < s->dx * s->dx * (1 - 1e-9) || w < s->dx * (1 - 1e-9))
+      return fail(c, "particles.dx",
+                  "%g m is too coarse for fluid.%u (%g m wide, area %g m^2): a block must hold "
+                  "at least one particle",
+                  s->dx, i, w, area);
+  }
+  /* walls */
+  if (d->n_walls) {
+    s->walls = calloc(d->n_walls, sizeof *s->walls);
+    if (!s->walls) return fail_oom(c);
+    s->n_walls = d->n_walls;
+  }
+  for (unsigned i = 0; i < d->n_walls; i++) {
+    const y_wall *y = &d->walls[i];
+    rhod_wall *w = &s->walls[i];
+    snprintf(path, sizeof path, "walls.%u", i);
+    TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &w->shape));
+    w->slip = y->slip ? (rhod_slip)*y->slip : RHOD_SLIP_FREE;
+    w->fluid_inside = opt_bool(y->fluid_inside, 1);
+  }
+  /* the default domain: bounding box of walls and fluid */
+  if (!s->has_domain) {
+    for (unsigned i = 0; i < s->n_fluid + s->n_walls; i++) {
+      const rhod_shape *sh = i < s->n_fluid ? &s->fluid[i].shape : &s->walls[i - s->n_fluid].shape;
+      double lo[2], hi[2];
+      shape_bbox(sh, lo, hi);
+      for (int a = 0; a < 2; a++) {
+        s->domain_min[a] = i ? fmin(s->domain_min[a], lo[a]) : lo[a];
+        s->domain_max[a] = i ? fmax(s->domain_max[a], hi[a]) : hi[a];
+      }
+    }
+  }
+  /* probes */
+  const y_probes *pr = d->probes;
+  s->probe_every = pr && pr->every ? *pr->every : s->output_every / 10;
+  TRY(check_positive(c, "probes.every", s->probe_every));
+  if (pr && pr->n_list) {
+    s->probes = calloc(pr->n_list, sizeof *s->probes);
+    if (!s->probes) return fail_oom(c);
+    s->n_probes = pr->n_list;
+  }
+  for (unsigned i = 0; i < s->n_probes; i++) {
+    char kind_path[96];
+    TRY(load_probe(c, &pr->list[i], i, &s->probes[i], kind_path, sizeof kind_path));
+    if (s->probes[i].kind == RHOD_PROBE_PRESSURE && s->has_domain) {
+      double *at = s->probes[i].at;
+      if (!inside_box(at, at, s->domain_min, s->domain_max)) {
+        snprintf(path, sizeof path, "%s.at", kind_path);
+        return fail(c, path, "[%g, %g] lies outside the domain", at[0], at[1]);
+      }
+    }
+    char mine[2][NAME_MAX_LEN + 3], other[2][NAME_MAX_LEN + 3];
+    unsigned nm = probe_columns(&s->probes[i], mine);
+    for (unsigned j = 0; j < i; j++) {
+      unsigned no = probe_columns(&s->probes[j], other);
+      for (unsigned a = 0; a < nm; a++)
+        for (unsigned b = 0; b < no; b++)
+          if (strcmp(mine[a], other[b]) == 0) {
+            snprintf(path, sizeof path, "%s.name", kind_path);
+            return fail(c, path, "duplicate probe column '%s' (also from probes.list.%u)", mine[a],
+                        j);
+          }
+    }
+  }
+  /* output */
+  const y_picture *pic = d->output ? d->output->picture : NULL;
+  s->picture_field = pic && pic->field ? (rhod_field)*pic->field : RHOD_FIELD_PRESSURE;
+  double width = pic && pic->width ? *pic->width : 800;
+  if (!(width >= 64 && width <= 8192 && width == floor(width)))
+    return fail(c, "output.picture.width", "must be a whole number of pixels in [64, 8192], got %g",
+                width);
+  s->picture_width = (unsigned)width;
+  if (pic && pic->range) {
+    s->picture_range_set = 1;
+    s->picture_range[0] = pic->range[0];
+    s->picture_range[1] = pic->range[1];
+    if (!(pic->range[0] < pic->range[1]))
+      return fail(c, "output.picture.range", "low (%g) must be below high (%g)", pic->range[0],
+                  pic->range[1]);
+  }
+  /* name */
+  if (d->name) {
+    if (!valid_name(d->name))
+      return fail(c, "name", "'%s' is not a valid name (letters, digits, '_', '.', '-')", d->name);
+    s->name = strdup(d->name);
+  } else {
+    s->name = default_name(c->file);
+  }
+  if (!s->name) return fail_oom(c);
+  return RHOD_OK;
+}
+
+/* ---- the scene as run, as a tree -------------------------------------------------------- */
+
+/* Shortest text that reads back as v; plain decimals between 1e-4 and 1e15. */
+static void fmt_num(double v, char *buf, size_t len) {
+  int p = 1;
+  for (; p < 17; p++) {
+    snprintf(buf, len, "%.*g", p, v);
+    if (strtod(buf, NULL) == v) break;
+  }
+  if (p == 17) snprintf(buf, len, "%.17g", v);
+  if (strchr(buf, 'e') && fabs(v) >= 1e-4 && fabs(v) < 1e15) {
+    int decimals = p - 1 - (int)floor(log10(fabs(v)));
+    char fixed[64];
+    snprintf(fixed, sizeof fixed, "%.*f", decimals > 0 ? decimals : 0, v);
+    if (strtod(fixed, NULL) == v && strlen(fixed) < len) memcpy(buf, fixed, strlen(fixed) + 1);
+  }
+}
+
+typedef struct {
+  int oom;
+} tb;
+
+static ry_node *tb_add(tb *t, ry_node *parent, const char *key, ry_node *n) {
+  if (!n) t->oom = 1;
+  if (t->oom || !parent) {
+    if (parent) ry_free(n);
+    return t->oom ? NULL : n;
+  }
+  if (parent->kind == RY_MAP ? ry_map_set(parent, key, n) : ry_seq_append(parent, n)) {
+    ry_free(n);
+    t->oom = 1;
+    return NULL;
+  }
+  return n;
+}
+
+static ry_node *tb_coll(tb *t, ry_node *parent, const char *key, ry_kind kind, int flow) {
+  if (t->oom) return NULL;
+  ry_node *n = ry_new(kind, -1, 0, 0);
+  if (n) n->flow = flow;
+  return tb_add(t, parent, key, n);
+}
+
+/* Text that YAML readers would take for a boolean, a null or a number is quoted, so that
+ * e.g. slip: "no" stays a word for a Python reader of the scene as run. */
+static int looks_typed(const char *v) {
+  static const char *const words[] = {"y", "n", "yes", "no", "on", "off", "true", "false", "null", "~"};
+  double num;
+  if (!v[0] || parse_number(v, &num)) return 1;
+  for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
+    if (strcasecmp(v, words[i]) == 0) return 1;
+  return 0;
+}
+
+static void tb_word(tb *t, ry_node *parent, const char *key, const char *v) {
+  if (t->oom) return;
+  ry_node *n = tb_add(t, parent, key, ry_new_scalar(v, -1, 0, 0));
+  if (n) n->quoted = looks_typed(v);
+}
+
+static void tb_str(tb *t, ry_node *parent, const char *key, const char *v) {
+  if (!t->oom) tb_add(t, parent, key, ry_new_scalar(v, -1, 0, 0));
+}
+
+static void tb_num(tb *t, ry_node *parent, const char *key, double v) {
+  char buf[40];
+  fmt_num(v, buf, sizeof buf);
+  tb_str(t, parent, key, buf);
+}
+
+static void tb_bool(tb *t, ry_node *parent, const char *key, int v) {
+  tb_str(t, parent, key, v ? "true" : "false");
+}
+
+static void tb_vec(tb *t, ry_node *parent, const char *key, const double v[2]) {
+  ry_node *seq = tb_coll(t, parent, key, RY_SEQ, 1);
+  tb_num(t, seq, NULL, v[0]);
+  tb_num(t, seq, NULL, v[1]);
+}
+
+static void tb_shape(tb *t, ry_node *entry, const rhod_shape *sh) {
+  ry_node *m;
+  switch (sh->kind) {
+  case RHOD_SHAPE_RECT:
+    m = tb_coll(t, entry, "rect", RY_MAP, 1);
+    tb_vec(t, m, "min", sh->min);
+    tb_vec(t, m, "max", sh->max);
+    break;
+  case RHOD_SHAPE_CIRCLE:
+    m = tb_coll(t, entry, "circle", RY_MAP, 1);
+    tb_vec(t, m, "center", sh->center);
+    tb_num(t, m, "radius", sh->radius);
+    break;
+  case RHOD_SHAPE_POLYGON:
+    m = tb_coll(t, entry, "polygon", RY_SEQ, 1);
+    for (unsigned i = 0; i < sh->n_points; i++) tb_vec(t, m, NULL, sh->points[i]);
+    break;
+  }
+}
+
+static const char *strval_name(const cyaml_strval_t *sv, size_t n, int v) {
+  for (size_t i = 0; i < n; i++)
+    if (sv[i].val == v) return sv[i].str;
+  return "?";
+}
+
+static ry_node *scene_tree(const rhod_scene *s) {
+  tb t = {0};
+  ry_node *root = tb_coll(&t, NULL, NULL, RY_MAP, 0), *m, *e;
+  if (s->name) tb_word(&t, root, "name", s->name);
+  m = tb_coll(&t, root, "time", RY_MAP, 0);
+  tb_num(&t, m, "end", s->t_end);
+  tb_num(&t, m, "output_every", s->output_every);
+  tb_num(&t, m, "cfl", s->cfl);
+  tb_num(&t, m, "cfl_visc", s->cfl_visc);
+  m = tb_coll(&t, root, "particles", RY_MAP, 0);
+  tb_num(&t, m, "dx", s->dx);
+  tb_num(&t, m, "radius_ratio", s->radius_ratio);
+  tb_word(&t, m, "kernel", strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
+  m = tb_coll(&t, root, "physics", RY_MAP, 0);
+  tb_num(&t, m, "rho0", s->rho0);
+  tb_num(&t, m, "c0", s->c0);
+  tb_num(&t, m, "mu", s->mu);
+  tb_vec(&t, m, "gravity", s->gravity);
+  m = tb_coll(&t, root, "scheme", RY_MAP, 0);
+  tb_bool(&t, m, "riemann", s->riemann);
+  tb_bool(&t, m, "reconstruction", s->reconstruction);
+  tb_bool(&t, m, "shifting", s->shifting);
+  tb_num(&t, m, "shifting_a", s->shift_a);
+  tb_num(&t, m, "shifting_b", s->shift_b);
+  tb_num(&t, m, "shifting_eps", s->shift_eps);
+  tb_bool(&t, m, "acoustic_damper", s->acoustic_damper);
+  tb_num(&t, m, "alpha_ad", s->alpha_ad);
+  tb_bool(&t, m, "free_surface", s->free_surface);
+  double lambda[2] = {s->fs_lambda_low, s->fs_lambda_high};
+  tb_vec(&t, m, "free_surface_lambda", lambda);
+  tb_num(&t, m, "shepard_threshold", s->shepard_threshold);
+  tb_num(&t, m, "theta_threshold", s->theta_threshold);
+  m = tb_coll(&t, root, "domain", RY_MAP, 0);
+  if (s->has_domain) {
+    tb_vec(&t, m, "min", s->domain_min);
+    tb_vec(&t, m, "max", s->domain_max);
+  }
+  e = tb_coll(&t, m, "periodic", RY_SEQ, 1);
+  tb_bool(&t, e, NULL, s->periodic[0]);
+  tb_bool(&t, e, NULL, s->periodic[1]);
+  m = tb_coll(&t, root, "fluid", RY_SEQ, 0);
+  for (unsigned i = 0; i < s->n_fluid; i++) {
+    e = tb_coll(&t, m, NULL, RY_MAP, 0);
+    tb_shape(&t, e, &s->fluid[i].shape);
+    tb_vec(&t, e, "velocity", s->fluid[i].velocity);
+    tb_word(&t, e, "pressure",
+           strval_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
+  }
+  m = tb_coll(&t, root, "walls", RY_SEQ, s->n_walls == 0);
+  for (unsigned i = 0; i < s->n_walls; i++) {
+    e = tb_coll(&t, m, NULL, RY_MAP, 0);
+    tb_shape(&t, e, &s->walls[i].shape);
+    tb_word(&t, e, "slip", strval_name(slip_names, CYAML_ARRAY_LEN(slip_names), (int)s->walls[i].slip));
+    tb_bool(&t, e, "fluid_inside", s->walls[i].fluid_inside);
+  }
+  m = tb_coll(&t, root, "probes", RY_MAP, 0);
+  tb_num(&t, m, "every", s->probe_every);
+  m = tb_coll(&t, m, "list", RY_SEQ, s->n_probes == 0);
+  for (unsigned i = 0; i < s->n_probes; i++) {
+    const rhod_probe *p = &s->probes[i];
+    e = tb_coll(&t, m, NULL, RY_MAP, 0);
+    unsigned kind = (unsigned)p->kind < 7 ? (unsigned)p->kind : 0;
+    ry_node *b = tb_coll(&t, e, probe_kind_names[kind], RY_MAP, 1);
+    if (p->name) tb_word(&t, b, "name", p->name);
+    if (p->kind == RHOD_PROBE_PRESSURE || p->kind == RHOD_PROBE_ANGULAR_MOMENTUM)
+      tb_vec(&t, b, "at", p->at);
+    if (p->kind == RHOD_PROBE_FRONT) tb_vec(&t, b, "direction", p->direction);
+  }
+  m = tb_coll(&t, root, "output", RY_MAP, 0);
+  m = tb_coll(&t, m, "picture", RY_MAP, 0);
+  tb_word(&t, m, "field",
+         strval_name(field_names, CYAML_ARRAY_LEN(field_names), (int)s->picture_field));
+  tb_num(&t, m, "width", s->picture_width);
+  if (s->picture_range_set) tb_vec(&t, m, "range", s->picture_range);
+  if (t.oom) {
+    ry_free(root);
+    return NULL;
+  }
+  return root;
+}
+
+/* ---- public API ------------------------------------------------------------------------ */
+
+static int read_all(const char *path, char **text, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return errno ? errno : EIO;
+  size_t cap = 4096, n = 0;
+  char *buf = malloc(cap);
+  int e = 0;
+  while (buf) {
+    if (n + 1 >= cap) {
+      char *nb = realloc(buf, cap *= 2);
+      if (!nb) {
+        free(buf);
+        buf = NULL;
+        break;
+      }
+      buf = nb;
+    }
+    size_t got = fread(buf + n, 1, cap - n - 1, f);
+    n += got;
+    if (got == 0) {
+      if (ferror(f)) e = errno ? errno : EIO;
+      break;
+    }
+  }
+  fclose(f);
+  if (!buf) return ENOMEM;
+  if (e) {
+    free(buf);
+    return e;
+  }
+  buf[n] = '\0';
+  *text = buf;
+  *len = n;
+  return 0;
+}
+
+void rhod_scene_free(rhod_scene *s) {
+  if (!s) return;
+  for (unsigned i = 0; i < s->n_fluid; i++) free(s->fluid[i].shape.points);
+  for (unsigned i = 0; i < s->n_walls; i++) free(s->walls[i].shape.points);
+  for (unsigned i = 0; i < s->n_probes; i++) free(s->probes[i].name);
+  free(s->fluid);
+  free(s->walls);
+  free(s->probes);
+  free(s->name);
+  free(s->path);
+  free(s->yaml);
+  free(s);
+}
+
+static int load_document(lctx *c, rhod_scene **out) {
+  int rc;
+  for (int k = 0; k < c->n_ov; k++)
+    if ((rc = apply_override(c, k))) return rc;
+  annotate(c->root, &sch_doc);
+
+  /* the text libcyaml reads, and where each node sits in it */
+  char *text = NULL;
+  size_t len = 0;
+  if (ry_emit(c->root, &text, &len)) return fail_oom(c);
+  ry_node *emitted = NULL;
+  ry_error ye;
+  if (ry_parse(text, len, -1, &emitted, &ye)) {
+    free(text);
+    return ye.oom ? fail_oom(c) : fail_at(c, c->root, "", "internal: %s", ye.msg);
+  }
+  ry_set_emitted_marks(c->root, emitted);
+  ry_free(emitted);
+
+  cy_log log = {.len = 0};
+  cyaml_config_t cfg = {
+      .log_fn = cy_log_fn,
+      .log_ctx = &log,
+      .mem_fn = cyaml_mem,
+      .log_level = CYAML_LOG_ERROR,
+      .flags = CYAML_CFG_NO_ALIAS,
+  };
+  y_doc *doc = NULL;
+  log.text[0] = '\0';
+  cyaml_err_t cerr = cyaml_load_data((const uint8_t *)text, len, &cfg, &sch_doc, (void **)&doc, NULL);
+  free(text);
+  if (cerr != CYAML_OK) return cyaml_failure(c, cerr, &log);
+  if (!doc) return fail_at(c, c->root, "time", "missing required key");
+
+  rc = check_scalars(c, c->root);
+  rhod_scene *s = NULL;
+  if (!rc) {
+    s = calloc(1, sizeof *s);
+    rc = s ? convert(c, doc, s) : fail_oom(c);
+  }
+  cyaml_free(&cfg, &sch_doc, doc, 0);
+  if (!rc) {
+    ry_node *tree = scene_tree(s);
+    s->path = strdup(c->file);
+    if (!tree || !s->path || ry_emit(tree, &s->yaml, NULL)) rc = fail_oom(c);
+    ry_free(tree);
+  }
+  if (rc) {
+    rhod_scene_free(s);
+    return rc;
+  }
+  *out = s;
+  return RHOD_OK;
+}
+
+int rhod_scene_load(const char *path, const char *const *overrides, int n_overrides,
+                    rhod_scene **out, char *err, size_t errlen) {
+  if (err && errlen) err[0] = '\0';
+  if (!out) return RHOD_ERR_USAGE;
+  *out = NULL;
+  lctx c = {
+      .file = path ? path : "(no file)",
+      .ov = overrides,
+      .n_ov = overrides ? (n_overrides > 0 ? n_overrides : 0) : 0,
+      .err = err,
+      .errlen = errlen,
+  };
+  if (!path) {
+    put_msg(&c, "%s: cannot read: no file given", c.file);
+    return RHOD_ERR_READ;
+  }
+  char *text = NULL;
+  size_t len = 0;
+  int e = read_all(path, &text, &len);
+  if (e) {
+    if (e == ENOMEM) return fail_oom(&c);
+    put_msg(&c, "%s: cannot read: %s", path, strerror(e));
+    return RHOD_ERR_READ;
+  }
+  ry_error ye;
+  int rc;
+  if (ry_parse(text, len, -1, &c.root, &ye)) {
+    if (ye.oom)
+      rc = fail_oom(&c);
+    else
+      rc = (put_msg(&c, "%s:%u:%u: %s: %s", path, ye.line, ye.col, shown(ye.path), ye.msg),
+            RHOD_ERR_SCENE);
+  } else if (!c.root && !(c.root = ry_new(RY_MAP, -1, 1, 1))) {
+    rc = fail_oom(&c);
+  } else {
+    rc = load_document(&c, out);
+  }
+  ry_free(c.root);
+  free(text);
+  return rc;
+}
+
+/* ---- parameters ------------------------------------------------------------------------- */
+
+static int inline_only(const ry_node *n) {
+  if (n->kind == RY_MAP) return 0;
+  for (unsigned i = 0; i < n->n; i++)
+    if (!inline_only(n->items[i])) return 0;
+  return 1;
+}
+
+static void inline_text(const ry_node *n, char *buf, size_t len, size_t *used) {
+  if (n->kind == RY_SCALAR) {
+    *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "%s", n->text);
+    return;
+  }
+  *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "[");
+  for (unsigned i = 0; i < n->n; i++) {
+    if (i) *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, ", ");
+    inline_text(n->items[i], buf, len, used);
+  }
+  *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "]");
+}
+
+static int param_push(rhod_param_list *p, unsigned *cap, const char *key, const char *value) {
+  if (p->n == *cap) {
+    unsigned nc = *cap ? 2 * *cap : 64;
+    char **k = realloc(p->keys, nc * sizeof *k);
+    if (!k) return -1;
+    p->keys = k;
+    char **v = realloc(p->values, nc * sizeof *v);
+    if (!v) return -1;
+    p->values = v;
+    *cap = nc;
+  }
+  p->keys[p->n] = strdup(key);
+  p->values[p->n] = strdup(value);
+  if (!p->keys[p->n] || !p->values[p->n]) {
+    free(p->keys[p->n]);
+    free(p->values[p->n]);
+    return -1;
+  }
+  p->n++;
+  return 0;
+}
+
+static int flatten(const ry_node *n, const char *path, rhod_param_list *p, unsigned *cap) {
+  if (n->kind == RY_SCALAR) return param_push(p, cap, path, n->text);
+  if (n->kind == RY_SEQ && inline_only(n)) {
+    size_t used = 0;
+    inline_text(n, NULL, 0, &used);
+    char *buf = malloc(used + 1);
+    if (!buf) return -1;
+    used = 0;
+    inline_text(n, buf, SIZE_MAX, &used);
+    int rc = param_push(p, cap, path, buf);
+    free(buf);
+    return rc;
+  }
+  if (n->kind == RY_MAP && n->n == 0) return param_push(p, cap, path, "{}");
+  for (unsigned i = 0; i < n->n; i++) {
+    char idx[16];
+    const char *seg = n->kind == RY_MAP ? n->keys[i]->text : (snprintf(idx, sizeof idx, "%u", i), idx);
+    size_t len = strlen(path) + strlen(seg) + 2;
+    char *child = malloc(len);
+    if (!child) return -1;
+    snprintf(child, len, "%s%s%s", path, path[0] ? "." : "", seg);
+    int rc = flatten(n->items[i], child, p, cap);
+    free(child);
+    if (rc) return rc;
+  }
+  return 0;
+}
+
+int rhod_scene_params(const rhod_scene *s, rhod_param_list *out) {
+  if (!out) return RHOD_ERR_USAGE;
+  memset(out, 0, sizeof *out);
+  if (!s) return RHOD_ERR_USAGE;
+  ry_node *tree = scene_tree(s);
+  if (!tree) return RHOD_ERR_MEMORY;
+  unsigned cap = 0;
+  int rc = flatten(tree, "", out, &cap);
+  ry_free(tree);
+  if (rc) {
+    rhod_param_list_free(out);
+    return RHOD_ERR_MEMORY;
+  }
+  return RHOD_OK;
+}
+
+void rhod_param_list_free(rhod_param_list *p) {
+  if (!p) return;
+  for (unsigned i = 0; i < p->n; i++) {
+    free(p->keys[i]);
+    free(p->values[i]);
+  }
+  free(p->keys);
+  free(p->values);
+  memset(p, 0, sizeof *p);
+}
+
+/* ---- warnings --------------------------------------------------------------------------- */
+
+typedef struct {
+  char *buf;
+  size_t len, used;
+  int count;
+} warn_buf;
+
+static void warn(warn_buf *w, const char *fmt, ...) {
+  if (w->buf && w->len && w->used + 1 < w->len) {
+    if (w->count)
+      w->used += (size_t)snprintf(w->buf + w->used, w->len - w->used, "\n");
+    if (w->used + 1 < w->len) {
+      va_list ap;
+      va_start(ap, fmt);
+      int n = vsnprintf(w->buf + w->used, w->len - w->used, fmt, ap);
+      va_end(ap);
+      if (n > 0) w->used += (size_t)n;
+      if (w->used >= w->len) w->used = w->len - 1;
+    }
+  }
+  w->count++;
+}
+
+/* Extent of all fluid blocks along the unit vector e: [lo, hi] of x.e. */
+static void fluid_extent(const rhod_scene *s, const double e[2], double *lo, double *hi) {
+  *lo = INFINITY;
+  *hi = -INFINITY;
+  for (unsigned i = 0; i < s->n_fluid; i++) {
+    const rhod_shape *sh = &s->fluid[i].shape;
+    switch (sh->kind) {
+    case RHOD_SHAPE_RECT:
+      for (int cx = 0; cx < 2; cx++)
+        for (int cy = 0; cy < 2; cy++) {
+          double x = (cx ? sh->max[0] : sh->min[0]) * e[0] + (cy ? sh->max[1] : sh->min[1]) * e[1];
+          *lo = fmin(*lo, x);
+          *hi = fmax(*hi, x);
+        }
+      break;
+    case RHOD_SHAPE_CIRCLE: {
+      double x = sh->center[0] * e[0] + sh->center[1] * e[1];
+      *lo = fmin(*lo, x - sh->radius);
+      *hi = fmax(*hi, x + sh->radius);
+      break;
+    }
+    case RHOD_SHAPE_POLYGON:
+      for (unsigned k = 0; k < sh->n_points; k++) {
+        double x = sh->points[k][0] * e[0] + sh->points[k][1] * e[1];
+        *lo = fmin(*lo, x);
+        *hi = fmax(*hi, x);
+      }
+      break;
+    }
+  }
+}
+
+int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
+  warn_buf w = {buf, len, 0, 0};
+  if (buf && len) buf[0] = '\0';
+  if (!s) return 0;
+  const char *file = s->path ? s->path : "(scene)";
+
+  /* Eq. 2 of paper 002 */
+  double g = hypot(s->gravity[0], s->gravity[1]), H = 0, umax = 0;
+  if (g > 0 && s->n_fluid) {
+    double e[2] = {s->gravity[0] / g, s->gravity[1] / g}, lo, hi;
+    fluid_extent(s, e, &lo, &hi);
+    H = hi - lo;
+  }
+  for (unsigned i = 0; i < s->n_fluid; i++)
+    umax = fmax(umax, hypot(s->fluid[i].velocity[0], s->fluid[i].velocity[1]));
+  double du = sqrt(2 * g * H) + umax, dp = s->rho0 * g * H;
+  double bound = 10 * fmax(du, s->rho0 > 0 ? sqrt(dp / s->rho0) : 0);
+  if (s->c0 < bound * (1 - 1e-12))
+    warn(&w,
+         "%s: physics.c0: %g m/s is below the bound %.4g m/s of paper 002 Eq. 2, "
+         "c0 >= 10 max(dU_max, sqrt(dP_max/rho0)), with dU_max = sqrt(2|g|H) + max|u0| = %.4g m/s, "
+         "dP_max = rho0|g|H = %.4g Pa, H = %.4g m: the flow is not weakly compressible",
+         file, s->c0, bound, du, dp, H);
+
+  if (s->output_every > s->t_end)
+    warn(&w, "%s: time.output_every: %g s exceeds time.end = %g s: only the initial state is written",
+         file, s->output_every, s->t_end);
+
+  if (s->picture_range_set && s->picture_field == RHOD_FIELD_FREE_SURFACE)
+    warn(&w, "%s: output.picture.range: ignored for field free_surface (a flag, not a scale)", file);
+
+  for (int a = 0; a < 2; a++) {
+    if (!s->periodic[a] || !(s->dx > 0)) continue;
+    double L = s->domain_max[a] - s->domain_min[a], n = L / s->dx;
+    if (fabs(n - nearbyint(n)) > 1e-6 * fmax(1, n))
+      warn(&w,
+           "%s: domain.periodic: the domain length along %c (%g m) is not a multiple of "
+           "particles.dx (%g m): the lattice will not tile across the periodic boundary",
+           file, a ? 'y' : 'x', L, s->dx);
+  }
+  return w.count;
+}

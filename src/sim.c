@@ -1,0 +1,445 @@
+/* Simulation set-up, stepping, checks and probes. */
+#include "rhod/sim.h"
+#include "kernel.h"
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int in_shape(const rhod_shape *sh, double x, double y) {
+  if (sh->kind == RHOD_SHAPE_RECT)
+    return x >= sh->min[0] && x <= sh->max[0] && y >= sh->min[1] && y <= sh->max[1];
+  if (sh->kind == RHOD_SHAPE_CIRCLE)
+    return hypot(x - sh->center[0], y - sh->center[1]) <= sh->radius;
+  int inside = 0; /* even-odd rule */
+  for (unsigned a = 0, b = sh->n_points - 1; a < sh->n_points; b = a++) {
+    const double *P = sh->points[a], *Q = sh->points[b];
+    if ((P[1] > y) != (Q[1] > y) && x < (Q[0] - P[0]) * (y - P[1]) / (Q[1] - P[1]) + P[0])
+      inside = !inside;
+  }
+  return inside;
+}
+
+static void shape_box(const rhod_shape *sh, double lo[2], double hi[2]) {
+  if (sh->kind == RHOD_SHAPE_RECT) {
+    for (int a = 0; a < 2; a++) lo[a] = sh->min[a], hi[a] = sh->max[a];
+  } else if (sh->kind == RHOD_SHAPE_CIRCLE) {
+    for (int a = 0; a < 2; a++)
+      lo[a] = sh->center[a] - sh->radius, hi[a] = sh->center[a] + sh->radius;
+  } else {
+    lo[0] = lo[1] = HUGE_VAL;
+    hi[0] = hi[1] = -HUGE_VAL;
+    for (unsigned k = 0; k < sh->n_points; k++)
+      for (int a = 0; a < 2; a++) {
+        lo[a] = fmin(lo[a], sh->points[k][a]);
+        hi[a] = fmax(hi[a], sh->points[k][a]);
+      }
+  }
+}
+
+/* Highest point of a shape along -g (for the hydrostatic start). */
+static double shape_top(const rhod_shape *sh, double ex, double ey) {
+  if (sh->kind == RHOD_SHAPE_CIRCLE)
+    return sh->center[0] * ex + sh->center[1] * ey + sh->radius;
+  double lo[2], hi[2], best = -HUGE_VAL;
+  if (sh->kind == RHOD_SHAPE_POLYGON) {
+    for (unsigned k = 0; k < sh->n_points; k++)
+      best = fmax(best, sh->points[k][0] * ex + sh->points[k][1] * ey);
+    return best;
+  }
+  shape_box(sh, lo, hi);
+  const double cx[2] = {lo[0], hi[0]}, cy[2] = {lo[1], hi[1]};
+  for (int a = 0; a < 2; a++)
+    for (int b = 0; b < 2; b++) best = fmax(best, cx[a] * ex + cy[b] * ey);
+  return best;
+}
+
+static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
+  const rhod_scene *sc = s->sc;
+  const double dx = sc->dx;
+  /* count first, then fill */
+  for (int pass = 0; pass < 2; pass++) {
+    size_t n = 0;
+    for (unsigned b = 0; b < sc->n_fluid; b++) {
+      const rhod_fluid_block *B = &sc->fluid[b];
+      double lo[2], hi[2];
+      shape_box(&B->shape, lo, hi);
+      const long nx = (long)floor((hi[0] - lo[0]) / dx + 1e-9);
+      const long ny = (long)floor((hi[1] - lo[1]) / dx + 1e-9);
+      const double g = hypot(sc->gravity[0], sc->gravity[1]);
+      const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
+      const double top = shape_top(&B->shape, ex, ey);
+      const double c2 = sc->c0 * sc->c0;
+      for (long j = 0; j < ny; j++)
+        for (long i = 0; i < nx; i++) {
+          const double x = lo[0] + (i + 0.5) * dx, y = lo[1] + (j + 0.5) * dx;
+          if (!in_shape(&B->shape, x, y)) continue;
+          int taken = 0; /* a point of an earlier block is not filled twice */
+          for (unsigned e = 0; e < b && !taken; e++) taken = in_shape(&sc->fluid[e].shape, x, y);
+          if (taken) continue;
+          if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1]) continue;
+          if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0) continue;
+          if (pass == 1) {
+            rhod_particles *p = &s->p;
+            double P = 0;
+            if (B->pressure == RHOD_INIT_HYDROSTATIC) {
+              /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1) */
+              const double depth = top - (x * ex + y * ey);
+              P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
+            }
+            const double rho = sc->rho0 + P / c2; /* Eq. 2 */
+            p->x[n] = (real)x;
+            p->y[n] = (real)y;
+            p->ux[n] = (real)B->velocity[0];
+            p->uy[n] = (real)B->velocity[1];
+            p->rho[n] = (real)rho;
+            p->m[n] = (real)(rho * dx * dx); /* m_i = rho_i(0) V_i(0) */
+            p->dx[n] = (real)dx;
+            p->id[n] = n;
+          }
+          n++;
+        }
+    }
+    if (pass == 0) {
+      if (n == 0) {
+        snprintf(err, errlen, "%s: fluid: no particle fits in the fluid blocks at dx = %g",
+                 sc->path, dx);
+        return RHOD_ERR_SCENE;
+      }
+      if (n > 2000000000u) {
+        snprintf(err, errlen, "%s: particles.dx: %zu particles is more than supported",
+                 sc->path, n);
+        return RHOD_ERR_SCENE;
+      }
+      int st = rhod_particles_reserve(&s->p, n + n / 2 + 256);
+      if (st != RHOD_OK) {
+        snprintf(err, errlen, "out of memory for %zu particles", n);
+        return st;
+      }
+    } else {
+      s->p.n = n;
+      s->p.next_id = n;
+    }
+  }
+  return RHOD_OK;
+}
+
+int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
+  memset(s, 0, sizeof *s);
+  s->sc = sc;
+  if (sc->has_domain) {
+    for (int a = 0; a < 2; a++) s->lo[a] = sc->domain_min[a], s->hi[a] = sc->domain_max[a];
+  } else {
+    s->lo[0] = s->lo[1] = HUGE_VAL;
+    s->hi[0] = s->hi[1] = -HUGE_VAL;
+    double lo[2], hi[2];
+    for (unsigned k = 0; k < sc->n_fluid + sc->n_walls; k++) {
+      const rhod_shape *sh =
+          k < sc->n_fluid ? &sc->fluid[k].shape : &sc->walls[k - sc->n_fluid].shape;
+      shape_box(sh, lo, hi);
+      for (int a = 0; a < 2; a++) s->lo[a] = fmin(s->lo[a], lo[a]), s->hi[a] = fmax(s->hi[a], hi[a]);
+    }
+  }
+  s->margin = sc->radius_ratio * sc->dx;
+  int st = rhod_particles_init(&s->p, 1024);
+  if (st == RHOD_OK) st = rhod_boundary_init(&s->bnd, sc, s->lo, s->hi);
+  if (st != RHOD_OK) {
+    snprintf(err, errlen, "out of memory setting up the particles");
+    return st;
+  }
+  /* host-side fill happens before anything is sent to the device */
+  st = fill_fluid(s, err, errlen);
+  if (st != RHOD_OK) return st;
+  st = rhod_sph_init(&s->sph, sc, &s->p);
+  if (st == RHOD_OK) st = rhod_rk4_init(&s->rk, &s->p);
+  rhod_particles *p = &s->p;
+  rhod_sph *h = &s->sph;
+  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->x, &h->vel, 2, 0);
+  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->y, &h->vel, 2, 1);
+  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->ux, &h->acc, 2, 0);
+  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->uy, &h->acc, 2, 1);
+  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
+  if (st != RHOD_OK) {
+    snprintf(err, errlen, "out of memory setting up the scheme");
+    return st;
+  }
+  /* the persistent state goes to the device */
+  for (int f = 0; f < p->nfields; f++)
+    if (p->fields[f].persistent) rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+  const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
+  const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
+  st = rhod_cells_init(&s->cells, glo, ghi, s->margin, p->cap);
+  if (st != RHOD_OK) {
+    snprintf(err, errlen, "%s: domain: too many cells for particles.dx = %g", sc->path, sc->dx);
+    return st;
+  }
+  s->dt = rhod_sph_dt(&s->sph, p);
+  return rhod_sim_prepare(s, 1);
+}
+
+void rhod_sim_free(rhod_sim *s) {
+  rhod_cells_free(&s->cells);
+  rhod_boundary_free(&s->bnd);
+  rhod_particles_free(&s->p);
+}
+
+/* Periodic wrap of the fluid into the box (once per step, before sorting). */
+static void wrap_periodic(rhod_sim *s) {
+  rhod_particles *p = &s->p;
+  const long n = (long)p->n;
+  real *x = p->x, *y = p->y;
+  const int px = s->bnd.periodic[0], py = s->bnd.periodic[1];
+  if (!px && !py) return;
+  const real lox = (real)s->lo[0], loy = (real)s->lo[1];
+  const real Lx = (real)(s->hi[0] - s->lo[0]), Ly = (real)(s->hi[1] - s->lo[1]);
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    if (px) {
+      if (x[i] < lox) x[i] += Lx;
+      else if (x[i] >= lox + Lx) x[i] -= Lx;
+    }
+    if (py) {
+      if (y[i] < loy) y[i] += Ly;
+      else if (y[i] >= loy + Ly) y[i] -= Ly;
+    }
+  }
+}
+
+int rhod_sim_prepare(rhod_sim *s, int sort) {
+  rhod_particles *p = &s->p;
+  if (sort) {
+    wrap_periodic(s);
+    p->ng = 0;
+    if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK) return RHOD_ERR_MEMORY;
+    rhod_cells_build(&s->cells, p->x, p->y, p->n);
+    /* the fluid part of the cell order is the new particle order */
+    int32_t *perm = p->perm;
+    const int32_t *idx = s->cells.idx;
+    const long n = (long)p->n;
+    RHOD_KERNEL_LOOP
+    for (long k = 0; k < n; k++) perm[k] = idx[k];
+    rhod_particles_permute(p);
+  }
+  int st = rhod_ghosts_build(&s->bnd, p, (real)s->sc->radius_ratio, (real)s->margin);
+  if (st != RHOD_OK) return st;
+  if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK) return RHOD_ERR_MEMORY;
+  rhod_sph_fill_state(&s->sph, p);
+  rhod_cells_build(&s->cells, p->x, p->y, p->n + p->ng);
+  s->neighbours_fresh = 1;
+  return RHOD_OK;
+}
+
+/* Finds the first fluid particle that is not finite or out of the domain. */
+static int check_state(rhod_sim *s, char *err, size_t errlen) {
+  rhod_particles *p = &s->p;
+  const long n = (long)p->n;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho;
+  const real lox = (real)s->lo[0], hix = (real)s->hi[0], loy = (real)s->lo[1],
+             hiy = (real)s->hi[1];
+  const int px = s->bnd.periodic[0], py = s->bnd.periodic[1];
+  /* periodic axes may sit up to one step outside before the wrap */
+  const real mx = px ? (real)s->margin : 0, my = py ? (real)s->margin : 0;
+  long bad = n;
+  RHOD_KERNEL_LOOP_REDUCE(min, bad)
+  for (long i = 0; i < n; i++) {
+    const int finite = isfinite(x[i]) && isfinite(y[i]) && isfinite(ux[i]) &&
+                       isfinite(uy[i]) && isfinite(rho[i]) && rho[i] > 0;
+    const int inside = x[i] >= lox - mx && x[i] <= hix + mx && y[i] >= loy - my &&
+                       y[i] <= hiy + my;
+    if (!(finite && inside) && i < bad) bad = i;
+  }
+  if (bad == n) return RHOD_OK;
+  real v[5];
+  rhod_to_host(p->x + bad, sizeof(real));
+  rhod_to_host(p->y + bad, sizeof(real));
+  rhod_to_host(p->ux + bad, sizeof(real));
+  rhod_to_host(p->uy + bad, sizeof(real));
+  rhod_to_host(p->rho + bad, sizeof(real));
+  rhod_to_host(p->id + bad, sizeof(uint64_t));
+  v[0] = p->x[bad], v[1] = p->y[bad], v[2] = p->ux[bad], v[3] = p->uy[bad], v[4] = p->rho[bad];
+  const unsigned long long id = (unsigned long long)p->id[bad];
+  const char *what;
+  if (!isfinite(v[4]) || !(v[4] > 0)) what = "density is not finite and positive";
+  else if (!isfinite(v[2]) || !isfinite(v[3])) what = "velocity is not finite";
+  else if (!isfinite(v[0]) || !isfinite(v[1])) what = "position is not finite";
+  else what = "left the domain";
+  snprintf(err, errlen,
+           "unstable at t = %.6g s (step %ld): particle id %llu %s (x = %g, y = %g, u = %g, "
+           "v = %g, rho = %g)",
+           s->t, s->step, id, what, (double)v[0], (double)v[1], (double)v[2], (double)v[3],
+           (double)v[4]);
+  return RHOD_ERR_UNSTABLE;
+}
+
+int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
+  rhod_particles *p = &s->p;
+  int st;
+  if (!s->neighbours_fresh) {
+    st = rhod_sim_prepare(s, 1);
+    if (st != RHOD_OK) goto mem;
+  }
+  rhod_rk4_begin(&s->rk, p);
+  for (int stage = 0; stage < 4; stage++) {
+    if (stage > 0) {
+      st = rhod_sim_prepare(s, 0);
+      if (st != RHOD_OK) goto mem;
+    }
+    rhod_sph_rhs(&s->sph, p, &s->cells, (real)dt);
+    rhod_rk4_stage(&s->rk, p, stage, (real)dt);
+  }
+  s->neighbours_fresh = 0;
+  s->reflected += rhod_walls_guard(&s->bnd, p);
+  s->t += dt;
+  s->step++;
+  return check_state(s, err, errlen);
+mem:
+  snprintf(err, errlen, "out of memory for the ghost particles at t = %g s", s->t);
+  return st;
+}
+
+static const char *probe_kind_name(rhod_probe_kind k) {
+  switch (k) {
+  case RHOD_PROBE_PRESSURE: return "pressure";
+  case RHOD_PROBE_KINETIC_ENERGY: return "kinetic_energy";
+  case RHOD_PROBE_POTENTIAL_ENERGY: return "potential_energy";
+  case RHOD_PROBE_FRONT: return "front";
+  case RHOD_PROBE_MASS: return "mass";
+  case RHOD_PROBE_MOMENTUM: return "momentum";
+  case RHOD_PROBE_ANGULAR_MOMENTUM: return "angular_momentum";
+  }
+  return "probe";
+}
+
+unsigned rhod_probe_columns(const rhod_scene *sc, const char **names, unsigned max) {
+  static char buf[64][80];
+  unsigned k = 0;
+  for (unsigned i = 0; i < sc->n_probes && k < max; i++) {
+    const rhod_probe *pr = &sc->probes[i];
+    const char *nm = pr->name ? pr->name : probe_kind_name(pr->kind);
+    if (pr->kind == RHOD_PROBE_MOMENTUM) {
+      for (int a = 0; a < 2 && k < max && k < 64; a++) {
+        snprintf(buf[k], sizeof buf[k], "%s_%c", nm, a ? 'y' : 'x');
+        names[k] = buf[k];
+        k++;
+      }
+    } else {
+      names[k++] = nm;
+    }
+  }
+  return k;
+}
+
+void rhod_probe_values(rhod_sim *s, double *values) {
+  const rhod_scene *sc = s->sc;
+  rhod_particles *p = &s->p;
+  rhod_sph *h = &s->sph;
+  const long n = (long)p->n, nt = (long)(p->n + p->ng);
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *m = p->m, *P = h->P, *V = h->V;
+  const int kern = h->kernel;
+  const real R = (real)(sc->radius_ratio * sc->dx);
+  const real gx = h->gx, gy = h->gy;
+  unsigned k = 0;
+  for (unsigned i = 0; i < sc->n_probes; i++) {
+    const rhod_probe *pr = &sc->probes[i];
+    const real ax = (real)pr->at[0], ay = (real)pr->at[1];
+    const real dx_ = (real)pr->direction[0], dy_ = (real)pr->direction[1];
+    switch (pr->kind) {
+    case RHOD_PROBE_PRESSURE: {
+      /* Shepard interpolation over fluid and ghosts; 0 where the support is dry
+       * (Gamma < 0.1) */
+      real num = 0, den = 0;
+      RHOD_KERNEL_LOOP_REDUCE2(+, num, den)
+      for (long j = 0; j < nt; j++) {
+        const real rx = x[j] - ax, ry = y[j] - ay;
+        const real w = rhod_W(kern, sqrt(rx * rx + ry * ry), R) * V[j];
+        num += w * P[j];
+        den += w;
+      }
+      values[k++] = den > (real)0.1 ? (double)(num / den) : 0.0;
+      break;
+    }
+    case RHOD_PROBE_KINETIC_ENERGY: {
+      real e = 0;
+      RHOD_KERNEL_LOOP_REDUCE(+, e)
+      for (long j = 0; j < n; j++) e += (real)0.5 * m[j] * (ux[j] * ux[j] + uy[j] * uy[j]);
+      values[k++] = e;
+      break;
+    }
+    case RHOD_PROBE_POTENTIAL_ENERGY: {
+      real e = 0;
+      RHOD_KERNEL_LOOP_REDUCE(+, e)
+      for (long j = 0; j < n; j++) e -= m[j] * (gx * x[j] + gy * y[j]);
+      values[k++] = e;
+      break;
+    }
+    case RHOD_PROBE_FRONT: {
+      real f = -(real)FLT_MAX;
+      RHOD_KERNEL_LOOP_REDUCE(max, f)
+      for (long j = 0; j < n; j++) {
+        const real v = x[j] * dx_ + y[j] * dy_;
+        f = v > f ? v : f;
+      }
+      values[k++] = f;
+      break;
+    }
+    case RHOD_PROBE_MASS: {
+      real e = 0;
+      RHOD_KERNEL_LOOP_REDUCE(+, e)
+      for (long j = 0; j < n; j++) e += m[j];
+      values[k++] = e;
+      break;
+    }
+    case RHOD_PROBE_MOMENTUM: {
+      real a = 0, b = 0;
+      RHOD_KERNEL_LOOP_REDUCE2(+, a, b)
+      for (long j = 0; j < n; j++) a += m[j] * ux[j], b += m[j] * uy[j];
+      values[k++] = a;
+      values[k++] = b;
+      break;
+    }
+    case RHOD_PROBE_ANGULAR_MOMENTUM: {
+      real a = 0;
+      RHOD_KERNEL_LOOP_REDUCE(+, a)
+      for (long j = 0; j < n; j++) a += m[j] * ((x[j] - ax) * uy[j] - (y[j] - ay) * ux[j]);
+      values[k++] = a;
+      break;
+    }
+    }
+  }
+}
+
+int rhod_sim_fetch(rhod_sim *s, rhod_host_copy *h) {
+  rhod_particles *p = &s->p;
+  const size_t n = p->n;
+  if (h->cap < n) {
+    rhod_host_copy_free(h);
+    h->cap = n + n / 4 + 16;
+#define A(f, t) h->f = malloc(h->cap * sizeof(t))
+    A(x, real); A(y, real); A(ux, real); A(uy, real); A(rho, real); A(p, real); A(m, real);
+    A(dx, real); A(id, uint64_t); A(fs, uint8_t);
+#undef A
+    if (!h->x || !h->y || !h->ux || !h->uy || !h->rho || !h->p || !h->m || !h->dx || !h->id ||
+        !h->fs)
+      return RHOD_ERR_MEMORY;
+  }
+  /* P and fs were computed for the prepared state: fill_state refreshes P */
+  rhod_sph_fill_state(&s->sph, p);
+  const real *src[8] = {p->x, p->y, p->ux, p->uy, p->rho, s->sph.P, p->m, p->dx};
+  real *dst[8] = {h->x, h->y, h->ux, h->uy, h->rho, h->p, h->m, h->dx};
+  for (int k = 0; k < 8; k++) {
+    rhod_to_host((void *)src[k], n * sizeof(real));
+    memcpy(dst[k], src[k], n * sizeof(real));
+  }
+  rhod_to_host(p->id, n * sizeof(uint64_t));
+  memcpy(h->id, p->id, n * sizeof(uint64_t));
+  rhod_to_host(s->sph.fs, n);
+  memcpy(h->fs, s->sph.fs, n);
+  return RHOD_OK;
+}
+
+void rhod_host_copy_free(rhod_host_copy *h) {
+  free(h->x), free(h->y), free(h->ux), free(h->uy), free(h->rho), free(h->p), free(h->m);
+  free(h->dx), free(h->id), free(h->fs);
+  memset(h, 0, sizeof *h);
+}

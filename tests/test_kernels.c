@@ -1,0 +1,339 @@
+/* Engine and scheme kernels: run in the host build and in the offload build. */
+#include "cunit_main.h"
+#include "kernel.h"
+#include "rhod/cells.h"
+#include "rhod/integrator.h"
+#include "rhod/sim.h"
+#include "rhod/sph.h"
+#include "sph_pair.h"
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef RHOD_SINGLE
+#define TOL(d, s) (s)
+#else
+#define TOL(d, s) (d)
+#endif
+
+/* deterministic pseudo-random numbers in [0, 1) */
+static double rnd(unsigned long *s) {
+  *s = *s * 6364136223846793005ul + 1442695040888963407ul;
+  return (double)((*s >> 11) & ((1ul << 53) - 1)) / (double)(1ul << 53);
+}
+
+static void test_kernel_normalisation(void) {
+  for (int kind = 0; kind < 3; kind++) {
+    const double R = 0.37;
+    /* integral of W over the disc by the midpoint rule in r */
+    double sum = 0, mom = 0;
+    const int N = 20000;
+    for (int k = 0; k < N; k++) {
+      const double r = (k + 0.5) * R / N;
+      sum += rhod_W(kind, (real)r, (real)R) * 2 * RHOD_PI * r * (R / N);
+      /* integral of dW/dr times r over the disc = -2 (gradient identity, 2D) */
+      mom += rhod_dW(kind, (real)r, (real)R) * r * 2 * RHOD_PI * r * (R / N);
+    }
+    CU_ASSERT_DOUBLE_EQUAL(sum, 1.0, TOL(1e-6, 1e-4));
+    CU_ASSERT_DOUBLE_EQUAL(mom, -2.0, TOL(1e-5, 1e-3));
+    CU_ASSERT_EQUAL(rhod_W(kind, (real)R, (real)R), 0);
+    CU_ASSERT_EQUAL(rhod_dW(kind, (real)(1.1 * R), (real)R), 0);
+    /* dW/dr against a central difference */
+    for (double q = 0.05; q < 0.99; q += 0.07) {
+      const double h = 1e-6 * R, r = q * R;
+      const double fd = (rhod_W(kind, (real)(r + h), (real)R) -
+                         rhod_W(kind, (real)(r - h), (real)R)) / (2 * h);
+#ifndef RHOD_SINGLE
+      CU_ASSERT_DOUBLE_EQUAL(rhod_dW(kind, (real)r, (real)R), fd, 1e-5 * fabs(fd) + 1e-6);
+#else
+      (void)fd;
+#endif
+    }
+  }
+}
+
+/* A minimal scene for the scheme's parameters. */
+static rhod_scene *unit_scene(double dx) {
+  rhod_scene *sc = calloc(1, sizeof *sc);
+  sc->t_end = 1, sc->output_every = 1, sc->cfl = 0.5, sc->cfl_visc = 0.025;
+  sc->dx = dx, sc->radius_ratio = 4, sc->kernel = RHOD_KERNEL_WENDLAND_C2;
+  sc->rho0 = 1000, sc->c0 = 20, sc->mu = 0;
+  sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = sc->free_surface = 1;
+  sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
+  sc->fs_lambda_low = 0.2, sc->fs_lambda_high = 0.75;
+  sc->shepard_threshold = 0.85, sc->theta_threshold = 0.95;
+  sc->path = "unit";
+  return sc;
+}
+
+/* A perturbed lattice of nx x ny particles of spacing dx in [0, nx dx] x [0, ny dx]. */
+typedef struct {
+  rhod_particles p;
+  rhod_cells c;
+  rhod_sph s;
+  rhod_scene *sc;
+} cloud;
+
+static void cloud_make(cloud *cl, int nx, int ny, double dx, double jitter, unsigned long seed) {
+  cl->sc = unit_scene(dx);
+  rhod_particles_init(&cl->p, (size_t)(nx * ny) + 16);
+  rhod_particles *p = &cl->p;
+  size_t n = 0;
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++) {
+      p->x[n] = (real)((i + 0.5 + jitter * (rnd(&seed) - 0.5)) * dx);
+      p->y[n] = (real)((j + 0.5 + jitter * (rnd(&seed) - 0.5)) * dx);
+      p->ux[n] = p->uy[n] = 0;
+      p->rho[n] = 1000;
+      p->m[n] = (real)(1000 * dx * dx);
+      p->dx[n] = (real)dx;
+      p->id[n] = n;
+      n++;
+    }
+  p->n = n;
+  rhod_sph_init(&cl->s, cl->sc, p);
+  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
+  rhod_cells_init(&cl->c, lo, hi, 4 * dx, p->cap);
+}
+
+static void cloud_sync(cloud *cl) {
+  rhod_particles *p = &cl->p;
+  for (int f = 0; f < p->nfields; f++)
+    if (p->fields[f].persistent) rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+}
+
+static void cloud_free(cloud *cl) {
+  rhod_cells_free(&cl->c);
+  rhod_particles_free(&cl->p);
+  free(cl->sc);
+}
+
+static void test_neighbours_brute_force(void) {
+  cloud cl;
+  cloud_make(&cl, 37, 23, 0.01, 0.9, 7);
+  cloud_sync(&cl);
+  rhod_particles *p = &cl.p;
+  rhod_cells_build(&cl.c, p->x, p->y, p->n);
+  rhod_to_host(cl.c.start, (cl.c.ncells + 1) * sizeof(int32_t));
+  rhod_to_host(cl.c.idx, p->n * sizeof(int32_t));
+  const rhod_grid G = cl.c.g;
+  const int32_t *CS = cl.c.start, *CI = cl.c.idx;
+  const real R = (real)0.04;
+  long mism = 0, total = 0;
+  for (size_t i = 0; i < p->n; i++) {
+    int found = 0, brute = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, p->x[i], p->y[i], j) {
+      const real rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i];
+      if (rx * rx + ry * ry < R * R) found++;
+    }
+    RHOD_END_NEIGHBOURS
+    for (size_t j = 0; j < p->n; j++) {
+      const real rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i];
+      if (rx * rx + ry * ry < R * R) brute++;
+    }
+    mism += found != brute;
+    total += brute;
+  }
+  CU_ASSERT_EQUAL(mism, 0);
+  CU_ASSERT(total > 30 * (long)p->n); /* about 50 neighbours each, fewer at the edges */
+  cloud_free(&cl);
+}
+
+static void test_sort_determinism(void) {
+  /* the same cloud sorted twice (and with different thread counts) gives the same order */
+  int32_t *first = NULL;
+  for (int rep = 0; rep < 3; rep++) {
+    cloud cl;
+    cloud_make(&cl, 50, 40, 0.01, 0.9, 11);
+    cloud_sync(&cl);
+    omp_set_num_threads(rep + 1);
+    rhod_cells_build(&cl.c, cl.p.x, cl.p.y, cl.p.n);
+    rhod_to_host(cl.c.idx, cl.p.n * sizeof(int32_t));
+    /* cells hold indices in increasing order */
+    rhod_to_host(cl.c.start, (cl.c.ncells + 1) * sizeof(int32_t));
+    int ordered = 1;
+    for (size_t k = 0; k < cl.c.ncells; k++)
+      for (int s = cl.c.start[k] + 1; s < cl.c.start[k + 1]; s++)
+        ordered &= cl.c.idx[s - 1] < cl.c.idx[s];
+    CU_ASSERT(ordered);
+    CU_ASSERT_EQUAL(cl.c.start[cl.c.ncells], (int32_t)cl.p.n);
+    if (!first) {
+      first = malloc(cl.p.n * sizeof(int32_t));
+      memcpy(first, cl.c.idx, cl.p.n * sizeof(int32_t));
+    } else {
+      CU_ASSERT_EQUAL(memcmp(first, cl.c.idx, cl.p.n * sizeof(int32_t)), 0);
+    }
+    cloud_free(&cl);
+  }
+  omp_set_num_threads(2);
+  free(first);
+}
+
+/* Pass A on a disordered cloud: the renormalised gradient (Eq. 14) is exact for a
+ * linear field, and grad Gamma vanishes inside. */
+static void test_renormalised_gradient_linear(void) {
+  cloud cl;
+  const double dx = 0.01;
+  cloud_make(&cl, 30, 30, dx, 0.8, 3);
+  rhod_particles *p = &cl.p;
+  rhod_sph *s = &cl.s;
+  const double a = 2.5, b = -1.25, c = 0.4;
+  const double c2 = 20.0 * 20.0;
+  for (size_t i = 0; i < p->n; i++) {
+    /* P = a x + b y + c through the EOS; u = (2x - y, 3y + x) */
+    p->rho[i] = (real)(1000 + (a * p->x[i] + b * p->y[i] + c) / c2);
+    p->ux[i] = (real)(2 * p->x[i] - p->y[i]);
+    p->uy[i] = (real)(3 * p->y[i] + p->x[i]);
+  }
+  cloud_sync(&cl);
+  rhod_sph_fill_state(s, p);
+  rhod_cells_build(&cl.c, p->x, p->y, p->n);
+  rhod_sph_rhs(s, p, &cl.c, (real)1e-4);
+  rhod_to_host(s->gP, 2 * p->n * sizeof(real));
+  rhod_to_host(s->gu, 4 * p->n * sizeof(real));
+  rhod_to_host(s->ggam, 2 * p->n * sizeof(real));
+  rhod_to_host(s->gam, p->n * sizeof(real));
+  double emax = 0, umax = 0, gmax = 0, gammin = 2;
+  int inner = 0;
+  for (size_t i = 0; i < p->n; i++) {
+    /* all particles, edges included: renormalisation is exact everywhere it inverts */
+    emax = fmax(emax, fabs(s->gP[2 * i] - a) + fabs(s->gP[2 * i + 1] - b));
+    const real *G = s->gu + 4 * i;
+    umax = fmax(umax, fabs(G[0] - 2) + fabs(G[1] + 1) + fabs(G[2] - 1) + fabs(G[3] - 3));
+    const double x = p->x[i], y = p->y[i];
+    if (x > 5 * dx && x < 25 * dx && y > 5 * dx && y < 25 * dx) {
+      inner++;
+      gmax = fmax(gmax, hypot(s->ggam[2 * i], s->ggam[2 * i + 1]) * dx);
+      gammin = fmin(gammin, s->gam[i]);
+    }
+  }
+  CU_ASSERT(inner > 100);
+  CU_ASSERT(emax < TOL(1e-6, 2e-2));
+  CU_ASSERT(umax < TOL(1e-8, 2e-3));
+  /* Gamma on a strongly disordered cloud is only roughly 1 */
+  CU_ASSERT(gmax < 0.5);
+  CU_ASSERT(gammin > 0.8);
+  cloud_free(&cl);
+}
+
+/* Free-surface detection on a square block: the outer layer is F, the inside is not. */
+static void test_free_surface_square(void) {
+  cloud cl;
+  const int N = 24;
+  cloud_make(&cl, N, N, 0.01, 0.0, 1);
+  rhod_particles *p = &cl.p;
+  cloud_sync(&cl);
+  rhod_sph_fill_state(&cl.s, p);
+  rhod_cells_build(&cl.c, p->x, p->y, p->n);
+  rhod_sph_rhs(&cl.s, p, &cl.c, (real)1e-4);
+  rhod_to_host(cl.s.fs, p->n);
+  rhod_to_host(cl.s.reg, p->n);
+  rhod_to_host(cl.s.gam, p->n * sizeof(real));
+  rhod_to_host(cl.s.ggam, 2 * p->n * sizeof(real));
+  int wrong_edge = 0, wrong_inside = 0, vicinity = 0;
+  double gdev = 0, ggmax = 0;
+  for (int j = 0; j < N; j++)
+    for (int i = 0; i < N; i++) {
+      const size_t k = (size_t)(j * N + i);
+      const int edge = i == 0 || j == 0 || i == N - 1 || j == N - 1;
+      const int deep = i >= 4 && j >= 4 && i < N - 4 && j < N - 4;
+      if (edge && !cl.s.fs[k]) wrong_edge++;
+      if (!edge && cl.s.fs[k]) wrong_inside++;
+      if (!edge && !deep && cl.s.reg[k] == 1) vicinity++;
+      if (deep && cl.s.reg[k] != 0) wrong_inside++;
+      if (deep) {
+        gdev = fmax(gdev, fabs(cl.s.gam[k] - 1));
+        ggmax = fmax(ggmax, hypot(cl.s.ggam[2 * k], cl.s.ggam[2 * k + 1]) * 0.01);
+      }
+    }
+  /* Shepard sum of Eq. 7 on a regular lattice with R = 4 dx: 1 to within 0.5 % */
+  CU_ASSERT(gdev < 5e-3);
+  CU_ASSERT(ggmax < TOL(1e-9, 1e-5));
+  CU_ASSERT_EQUAL(wrong_edge, 0);
+  CU_ASSERT_EQUAL(wrong_inside, 0);
+  CU_ASSERT(vicinity > 0);
+  cloud_free(&cl);
+}
+
+/* PVRS (Eqs. 17, 19) and the limiter (Eq. 15) against hand-worked values. */
+static void test_pvrs_hand_values(void) {
+  real uE, PE;
+  /* rho_L = 1000, rho_R = 1002, u_L = 1, u_R = -1, P_L = 0, P_R = 800, c0 = 20:
+   * u_E = (1002 * (-1) + 1000 * 1)/2002 + (0 - 800)/(20 * 2002) = -2/2002 - 800/40040
+   *     = -0.000999000999 - 0.01998001998 = -0.02097902098
+   * P_E = (1002 * 0 + 1000 * 800)/2002 + 1000 * 1002 * 20 * 2 / 2002
+   *     = 399.6003996 + 20019.98002 = 20419.58042 */
+  rhod_pvrs(1000, 1002, 1, -1, 0, 800, 20, &uE, &PE);
+  CU_ASSERT_DOUBLE_EQUAL(uE, -0.02097902098, TOL(1e-9, 1e-5));
+  CU_ASSERT_DOUBLE_EQUAL(PE, 20419.58042, TOL(1e-5, 5e-2));
+  /* equal states: u_E = u, P_E = P */
+  rhod_pvrs(1000, 1000, 0.3, 0.3, 50, 50, 20, &uE, &PE);
+  CU_ASSERT_DOUBLE_EQUAL(uE, 0.3, 1e-6);
+  CU_ASSERT_DOUBLE_EQUAL(PE, 50, 1e-4);
+  CU_ASSERT_DOUBLE_EQUAL(rhod_limit(2, 6), 3.0, 1e-6);
+  CU_ASSERT_DOUBLE_EQUAL(rhod_limit(-2, -6), -3.0, 1e-6);
+  CU_ASSERT_EQUAL(rhod_limit(2, -6), 0);
+  CU_ASSERT_EQUAL(rhod_limit(0, 1), 0);
+  /* states of Eq. 16 with w_i = 1/3 (i twice finer): phi_i = 0, phi_j = 3, r = 1, both
+   * gradients 3: L = 0 + 1/3 * 3 = 1, R = 3 - 2/3 * 3 = 1 (the linear value at x_ij) */
+  real L, Rr;
+  rhod_states(0, 3, 3, 3, 1, (real)(1.0 / 3), (real)(2.0 / 3), 1, &L, &Rr);
+  CU_ASSERT_DOUBLE_EQUAL(L, 1, 1e-6);
+  CU_ASSERT_DOUBLE_EQUAL(Rr, 1, 1e-6);
+}
+
+/* RK4 on dy/dt = -y, dx/dt = y: error ratio for halved dt near 2^4. */
+static void test_rk4_order(void) {
+  double err[2];
+  for (int k = 0; k < 2; k++) {
+    rhod_particles p;
+    rhod_particles_init(&p, 4);
+    p.n = 1;
+    real *d = NULL;
+    rhod_particles_add_field(&p, "d", (void **)&d, 2 * sizeof(real), 0);
+    rhod_rk4 rk;
+    rhod_rk4_init(&rk, &p);
+    rhod_rk4_add(&rk, &p, &p.x, &d, 2, 0);
+    rhod_rk4_add(&rk, &p, &p.y, &d, 2, 1);
+    p.x[0] = 1, p.y[0] = 0;
+    rhod_to_device(p.x, sizeof(real));
+    rhod_to_device(p.y, sizeof(real));
+    const int nsteps = 10 << k;
+    const real dt = (real)(2.0 / nsteps);
+    for (int s = 0; s < nsteps; s++) {
+      rhod_rk4_begin(&rk, &p);
+      for (int st = 0; st < 4; st++) {
+        rhod_to_host(p.x, sizeof(real));
+        rhod_to_host(p.y, sizeof(real));
+        d[0] = -p.x[0]; /* x' = -x */
+        d[1] = p.x[0];  /* y' = x */
+        rhod_to_device(d, 2 * sizeof(real));
+        rhod_rk4_stage(&rk, &p, st, dt);
+      }
+    }
+    rhod_to_host(p.x, sizeof(real));
+    rhod_to_host(p.y, sizeof(real));
+    err[k] = fabs(p.x[0] - exp(-2.0)) + fabs(p.y[0] - (1 - exp(-2.0)));
+    rhod_particles_free(&p);
+  }
+#ifndef RHOD_SINGLE
+  const double order = log2(err[0] / err[1]);
+  CU_ASSERT(order > 3.8 && order < 4.3);
+#endif
+  CU_ASSERT(err[1] < 1e-5);
+}
+
+int main(void) {
+  omp_set_num_threads(2);
+  const rhod_test_case cases[] = {
+      {"kernel normalisation and gradient", test_kernel_normalisation},
+      {"neighbour search against brute force", test_neighbours_brute_force},
+      {"sort determinism", test_sort_determinism},
+      {"renormalised gradient exact for linear fields", test_renormalised_gradient_linear},
+      {"free-surface detection on a square", test_free_surface_square},
+      {"PVRS and limiter hand values", test_pvrs_hand_values},
+      {"RK4 fourth order", test_rk4_order},
+  };
+  return RHOD_RUN_TESTS("kernels", cases);
+}

@@ -1,0 +1,72 @@
+"""Reading rhod output folders: snapshots (HDF5), probes.csv, scene parameters.
+
+Used by the cases' check and study scripts. Needs Debian's python3-numpy and
+python3-h5py (installed by scripts/setup.sh)."""
+import csv
+import glob
+import json
+import os
+
+import h5py
+import numpy as np
+
+
+def snapshots(out):
+    """Sorted list of snapshot paths in an output folder."""
+    return sorted(glob.glob(os.path.join(out, "snapshot_*.h5")))
+
+
+def read_snapshot(path):
+    """Dict of numpy arrays (sorted by particle id) plus 'time'."""
+    with h5py.File(path, "r") as f:
+        g = f["PartType0"]
+        ids = g["ParticleIDs"][()]
+        order = np.argsort(ids)
+        d = {"time": float(f["Header"].attrs["Time"]), "id": ids[order]}
+        for key, name in (("pos", "Coordinates"), ("vel", "Velocities")):
+            d[key] = g[name][()][order, :2]
+        for key, name in (("rho", "Densities"), ("p", "Pressures"), ("m", "Masses"),
+                          ("size", "ParticleSizes")):
+            d[key] = g[name][()][order]
+    return d
+
+
+def parameters(out):
+    """The scene as run: dotted key -> string, from the first snapshot."""
+    snaps = snapshots(out)
+    if not snaps:
+        raise SystemExit(f"{out}: no snapshot_*.h5")
+    with h5py.File(snaps[0], "r") as f:
+        return {k: (v.decode() if isinstance(v, bytes) else str(v))
+                for k, v in f["Parameters"].attrs.items()}
+
+
+def number(params, key):
+    return float(params[key])
+
+
+def vector(params, key):
+    return [float(v) for v in params[key].strip("[] ").split(",")]
+
+
+def probes(out):
+    """Columns of probes.csv as numpy arrays."""
+    with open(os.path.join(out, "probes.csv")) as f:
+        rows = list(csv.reader(f))
+    head = rows[0]
+    data = np.array([[float(v) for v in r] for r in rows[1:] if r], dtype=float)
+    return {h: data[:, k] for k, h in enumerate(head)}
+
+
+def summary(out):
+    with open(os.path.join(out, "summary.json")) as f:
+        return json.load(f)
+
+
+def refdata(path):
+    """Columns of a reference CSV (comment lines start with #, then a header row)."""
+    with open(path) as f:
+        lines = [l for l in f if not l.startswith("#") and l.strip()]
+    head = lines[0].strip().split(",")
+    data = np.array([[float(v) for v in l.strip().split(",")] for l in lines[1:]])
+    return {h: data[:, k] for k, h in enumerate(head)}
