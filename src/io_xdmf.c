@@ -1,7 +1,13 @@
 /* The XDMF sidecar: OUT/snapshots.xdmf describes every snapshot_NNNN.h5 written so far as
- * one Polyvertex grid each, gathered in a temporal collection, so that ParaView (XDMF
- * reader) opens the run as a time series of particles with their fields. Rewritten
- * atomically after each snapshot. */
+ * one Polyvertex grid each, gathered in a temporal collection, so that ParaView opens the
+ * run as a time series of particles with their fields. Rewritten atomically after each
+ * snapshot.
+ *
+ * The layout follows SWIFT's .xmf files (XDMF 2): the Polyvertex topology has no
+ * connectivity array, so ParaView's "XDMF Reader" gives every particle its own vertex
+ * cell (Xdmf2's default connectivity 0..N-1). The Xdmf3 readers load the same points
+ * and fields without cells: use the Point Gaussian representation there. Particle ids
+ * are declared as 8-byte Int, as SWIFT does, which every XDMF reader maps. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "rhod/io.h"
@@ -46,7 +52,7 @@ static void grid(FILE *f, int index, double time, size_t n) {
   attribute(f, file, "Pressure", "Pressures", n, 0, "Float");
   attribute(f, file, "Mass", "Masses", n, 0, "Float");
   attribute(f, file, "ParticleSize", "ParticleSizes", n, 0, "Float");
-  attribute(f, file, "ParticleID", "ParticleIDs", n, 0, "UInt");
+  attribute(f, file, "ParticleID", "ParticleIDs", n, 0, "Int");
   fprintf(f, "      </Grid>\n");
 }
 
@@ -76,7 +82,7 @@ int rhod_write_xdmf(const char *dir, int count, const double *times, const size_
   }
   fprintf(f, "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
              "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-             "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+             "<Xdmf Version=\"2.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
              "  <Domain>\n"
              "    <Grid Name=\"particles\" GridType=\"Collection\" "
              "CollectionType=\"Temporal\">\n");

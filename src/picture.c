@@ -268,8 +268,10 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
     if (!isfinite(cx) || !isfinite(cy))
       continue;
     double r = 0.5 * (double)v->size[i] * sx;
-    if (!(r > 0) || !isfinite(r))
+    if (!(r > 0))
       r = 0;
+    if (r > 2.0 * (width + fh)) /* covers the frame already; keeps the pixel maths finite */
+      r = 2.0 * (width + fh);
     if (cx + r < 0 || cy + r < 0 || cx - r > width || cy - r > fh)
       continue;
     double f = field_value(v, field, i);

@@ -158,14 +158,13 @@ static const cyaml_schema_value_t sch_bool = {CYAML_VALUE_BOOL(CYAML_FLAG_DEFAUL
 static const cyaml_schema_value_t sch_vec = {
     CYAML_VALUE_SEQUENCE_FIXED(CYAML_FLAG_FLOW, double, &sch_float, 2)};
 
-#define VEC(key, flags, st, member)                                                              \
+#define VEC(key, flags, st, member)                                                                \
   CYAML_FIELD_SEQUENCE_FIXED(key, (flags) | CYAML_FLAG_FLOW, st, member, &sch_float, 2)
 #define NUM(key, st, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_STRICT, st, member)
 #define NUM_OPT(key, st, member) CYAML_FIELD_FLOAT_PTR(key, OPT | CYAML_FLAG_STRICT, st, member)
 #define BOOL_OPT(key, st, member) CYAML_FIELD_BOOL_PTR(key, OPT, st, member)
-#define ENUM_OPT(key, st, member, strings)                                                       \
-  CYAML_FIELD_ENUM_PTR(key, OPT | CYAML_FLAG_STRICT, st, member, strings,                        \
-                       CYAML_ARRAY_LEN(strings))
+#define ENUM_OPT(key, st, member, strings)                                                         \
+  CYAML_FIELD_ENUM_PTR(key, OPT | CYAML_FLAG_STRICT, st, member, strings, CYAML_ARRAY_LEN(strings))
 #define NAME_OPT(st) CYAML_FIELD_STRING_PTR("name", OPT, st, name, 1, NAME_MAX_LEN)
 
 static const cyaml_strval_t kernel_names[] = {
@@ -182,8 +181,8 @@ static const cyaml_strval_t slip_names[] = {
     {"no", RHOD_SLIP_NO},
 };
 static const cyaml_strval_t field_names[] = {
-    {"pressure", RHOD_FIELD_PRESSURE}, {"velocity", RHOD_FIELD_VELOCITY},
-    {"density", RHOD_FIELD_DENSITY},   {"size", RHOD_FIELD_SIZE},
+    {"pressure", RHOD_FIELD_PRESSURE},         {"velocity", RHOD_FIELD_VELOCITY},
+    {"density", RHOD_FIELD_DENSITY},           {"size", RHOD_FIELD_SIZE},
     {"free_surface", RHOD_FIELD_FREE_SURFACE},
 };
 static const char *const probe_kind_names[] = {
@@ -207,11 +206,8 @@ static const cyaml_schema_field_t f_particles[] = {
 };
 
 static const cyaml_schema_field_t f_physics[] = {
-    NUM_OPT("rho0", y_physics, rho0),
-    NUM("c0", y_physics, c0),
-    NUM_OPT("mu", y_physics, mu),
-    VEC("gravity", OPT, y_physics, gravity),
-    CYAML_FIELD_END,
+    NUM_OPT("rho0", y_physics, rho0),        NUM("c0", y_physics, c0), NUM_OPT("mu", y_physics, mu),
+    VEC("gravity", OPT, y_physics, gravity), CYAML_FIELD_END,
 };
 
 static const cyaml_schema_field_t f_scheme[] = {
@@ -233,8 +229,7 @@ static const cyaml_schema_field_t f_scheme[] = {
 static const cyaml_schema_field_t f_domain[] = {
     VEC("min", OPT, y_domain, min),
     VEC("max", OPT, y_domain, max),
-    CYAML_FIELD_SEQUENCE_FIXED("periodic", OPT | CYAML_FLAG_FLOW, y_domain, periodic, &sch_bool,
-                               2),
+    CYAML_FIELD_SEQUENCE_FIXED("periodic", OPT | CYAML_FLAG_FLOW, y_domain, periodic, &sch_bool, 2),
     CYAML_FIELD_END,
 };
 
@@ -250,10 +245,10 @@ static const cyaml_schema_field_t f_circle[] = {
     CYAML_FIELD_END,
 };
 
-#define SHAPE_FIELDS(st)                                                                         \
-  CYAML_FIELD_MAPPING_PTR("rect", OPT | CYAML_FLAG_FLOW, st, rect, f_rect),                      \
-      CYAML_FIELD_MAPPING_PTR("circle", OPT | CYAML_FLAG_FLOW, st, circle, f_circle),            \
-      CYAML_FIELD_SEQUENCE_COUNT("polygon", OPT | CYAML_FLAG_FLOW, st, polygon, n_polygon,       \
+#define SHAPE_FIELDS(st)                                                                           \
+  CYAML_FIELD_MAPPING_PTR("rect", OPT | CYAML_FLAG_FLOW, st, rect, f_rect),                        \
+      CYAML_FIELD_MAPPING_PTR("circle", OPT | CYAML_FLAG_FLOW, st, circle, f_circle),              \
+      CYAML_FIELD_SEQUENCE_COUNT("polygon", OPT | CYAML_FLAG_FLOW, st, polygon, n_polygon,         \
                                  &sch_vec, 3, CYAML_UNLIMITED)
 
 static const cyaml_schema_field_t f_fluid[] = {
@@ -294,7 +289,7 @@ static const cyaml_schema_field_t f_probe_angular[] = {
     CYAML_FIELD_END,
 };
 
-#define PROBE(key, member, fields)                                                               \
+#define PROBE(key, member, fields)                                                                 \
   CYAML_FIELD_MAPPING_PTR(key, OPT | CYAML_FLAG_FLOW, y_probe, member, fields)
 static const cyaml_schema_field_t f_probe[] = {
     PROBE("pressure", pressure, f_probe_point),
@@ -311,8 +306,7 @@ static const cyaml_schema_value_t sch_probe = {
 
 static const cyaml_schema_field_t f_probes[] = {
     NUM_OPT("every", y_probes, every),
-    CYAML_FIELD_SEQUENCE_COUNT("list", OPT, y_probes, list, n_list, &sch_probe, 0,
-                               CYAML_UNLIMITED),
+    CYAML_FIELD_SEQUENCE_COUNT("list", OPT, y_probes, list, n_list, &sch_probe, 0, CYAML_UNLIMITED),
     CYAML_FIELD_END,
 };
 
@@ -337,15 +331,13 @@ static const cyaml_schema_field_t f_doc[] = {
     CYAML_FIELD_MAPPING_PTR("domain", OPT, y_doc, domain, f_domain),
     CYAML_FIELD_SEQUENCE_COUNT("fluid", CYAML_FLAG_POINTER, y_doc, fluid, n_fluid, &sch_fluid, 1,
                                CYAML_UNLIMITED),
-    CYAML_FIELD_SEQUENCE_COUNT("walls", OPT, y_doc, walls, n_walls, &sch_wall, 0,
-                               CYAML_UNLIMITED),
+    CYAML_FIELD_SEQUENCE_COUNT("walls", OPT, y_doc, walls, n_walls, &sch_wall, 0, CYAML_UNLIMITED),
     CYAML_FIELD_MAPPING_PTR("probes", OPT, y_doc, probes, f_probes),
     CYAML_FIELD_MAPPING_PTR("output", OPT, y_doc, output, f_output),
     CYAML_FIELD_END,
 };
 
-static const cyaml_schema_value_t sch_doc = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, y_doc, f_doc)};
+static const cyaml_schema_value_t sch_doc = {CYAML_VALUE_MAPPING(CYAML_FLAG_POINTER, y_doc, f_doc)};
 
 /* ---- loading context and messages ------------------------------------------------------ */
 
@@ -359,7 +351,8 @@ typedef struct {
 } lctx;
 
 static void put_msg(lctx *c, const char *fmt, ...) {
-  if (!c->err || !c->errlen) return;
+  if (!c->err || !c->errlen)
+    return;
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(c->err, c->errlen, fmt, ap);
@@ -376,8 +369,7 @@ static int vfail_at(lctx *c, const ry_node *n, const char *path, const char *fmt
   if (n && n->origin >= 0 && n->origin < c->n_ov)
     put_msg(c, "--set %s: %s: %s", c->ov[n->origin], shown(path), reason);
   else
-    put_msg(c, "%s:%u:%u: %s: %s", c->file, n ? n->line : 1u, n ? n->col : 1u, shown(path),
-            reason);
+    put_msg(c, "%s:%u:%u: %s: %s", c->file, n ? n->line : 1u, n ? n->col : 1u, shown(path), reason);
   return RHOD_ERR_SCENE;
 }
 
@@ -424,9 +416,11 @@ static int is_seq_schema(const cyaml_schema_value_t *s) {
 }
 
 static const cyaml_schema_field_t *schema_field(const cyaml_schema_value_t *s, const char *key) {
-  if (!s || s->type != CYAML_MAPPING) return NULL;
+  if (!s || s->type != CYAML_MAPPING)
+    return NULL;
   for (const cyaml_schema_field_t *f = s->mapping.fields; f->key; f++)
-    if (strcmp(f->key, key) == 0) return f;
+    if (strcmp(f->key, key) == 0)
+      return f;
   return NULL;
 }
 
@@ -502,19 +496,24 @@ typedef struct {
 
 static void cy_log_fn(cyaml_log_t level, void *ctx, const char *fmt, va_list args) {
   cy_log *l = ctx;
-  if (level < CYAML_LOG_ERROR || l->len + 1 >= sizeof l->text) return;
+  if (level < CYAML_LOG_ERROR || l->len + 1 >= sizeof l->text)
+    return;
   int n = vsnprintf(l->text + l->len, sizeof l->text - l->len, fmt, args);
-  if (n > 0) l->len += (size_t)n < sizeof l->text - l->len ? (size_t)n : sizeof l->text - l->len - 1;
+  if (n > 0)
+    l->len += (size_t)n < sizeof l->text - l->len ? (size_t)n : sizeof l->text - l->len - 1;
 }
 
 static ry_node *find_unknown_key(ry_node *n, const char *key) {
-  if (n->kind == RY_MAP && n->schema && ((const cyaml_schema_value_t *)n->schema)->type == CYAML_MAPPING) {
+  if (n->kind == RY_MAP && n->schema &&
+      ((const cyaml_schema_value_t *)n->schema)->type == CYAML_MAPPING) {
     ry_node *k = ry_map_key(n, key);
-    if (k && !schema_field(n->schema, key)) return k;
+    if (k && !schema_field(n->schema, key))
+      return k;
   }
   for (unsigned i = 0; i < n->n; i++) {
     ry_node *k = find_unknown_key(n->items[i], key);
-    if (k) return k;
+    if (k)
+      return k;
   }
   return NULL;
 }
@@ -527,21 +526,25 @@ static int lacks_required(const ry_node *m, const char *key) {
 static ry_node *find_missing(ry_node *n, const char *key) {
   for (unsigned i = 0; i < n->n; i++) {
     ry_node *m = find_missing(n->items[i], key);
-    if (m) return m;
+    if (m)
+      return m;
   }
   return lacks_required(n, key) ? n : NULL;
 }
 
 static int count_bad(const ry_node *n) {
   const cyaml_schema_value_t *s = n->schema;
-  return n->kind == RY_SEQ && is_seq_schema(s) && (n->n < s->sequence.min || n->n > s->sequence.max);
+  return n->kind == RY_SEQ && is_seq_schema(s) &&
+         (n->n < s->sequence.min || n->n > s->sequence.max);
 }
 
 static ry_node *find_bad_count(ry_node *n) {
-  if (count_bad(n)) return n;
+  if (count_bad(n))
+    return n;
   for (unsigned i = 0; i < n->n; i++) {
     ry_node *m = find_bad_count(n->items[i]);
-    if (m) return m;
+    if (m)
+      return m;
   }
   return NULL;
 }
@@ -549,7 +552,8 @@ static ry_node *find_bad_count(ry_node *n) {
 /* Builds the user's message from libcyaml's log: the reason from its first line, the place
  * from the innermost "(line: L, column: C)" of its backtrace. */
 static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
-  if (cerr == CYAML_ERR_OOM) return fail_oom(c);
+  if (cerr == CYAML_ERR_OOM)
+    return fail_oom(c);
   char reason[512] = "";
   unsigned line = 0, col = 0;
   for (const char *p = log->text; *p;) {
@@ -563,8 +567,10 @@ static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
     p += n + (eol ? 1 : 0);
   }
   size_t rl = strlen(reason);
-  while (rl && (reason[rl - 1] == '.' || reason[rl - 1] == ' ')) reason[--rl] = '\0';
-  if (!reason[0]) snprintf(reason, sizeof reason, "%s", cyaml_strerror(cerr));
+  while (rl && (reason[rl - 1] == '.' || reason[rl - 1] == ' '))
+    reason[--rl] = '\0';
+  if (!reason[0])
+    snprintf(reason, sizeof reason, "%s", cyaml_strerror(cerr));
 
   ry_node *at = line ? ry_find_emitted(c->root, line, col) : c->root;
   char path[256], want[600], got[256];
@@ -576,18 +582,24 @@ static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
     ry_node *k = NULL;
     for (ry_node *m = at->is_key ? at->parent : at; m && !k; m = m->parent) {
       ry_node *cand = m->kind == RY_MAP ? ry_map_key(m, arg) : NULL;
-      if (cand && !schema_field(m->schema, arg)) k = cand;
+      if (cand && !schema_field(m->schema, arg))
+        k = cand;
     }
-    if (!k) k = find_unknown_key(c->root, arg);
-    if (!k) return fail_at(c, at, path, "unknown key '%s'", arg);
+    if (!k)
+      k = find_unknown_key(c->root, arg);
+    if (!k)
+      return fail_at(c, at, path, "unknown key '%s'", arg);
     node_path(k, path, sizeof path);
     return fail_at(c, k, path, "unknown key");
   }
   if (strncmp(reason, "Missing required mapping field: ", 32) == 0) {
     ry_node *m = at->is_key ? at->parent : at;
-    while (m && !lacks_required(m, arg)) m = m->parent;
-    if (!m) m = find_missing(c->root, arg);
-    if (!m) return fail_at(c, at, path, "missing required key '%s'", arg);
+    while (m && !lacks_required(m, arg))
+      m = m->parent;
+    if (!m)
+      m = find_missing(c->root, arg);
+    if (!m)
+      return fail_at(c, at, path, "missing required key '%s'", arg);
     node_path(m, path, sizeof path);
     snprintf(want, sizeof want, "%s%s%s", path, path[0] ? "." : "", arg);
     /* a block mapping starts at its first key: point at the key that names it instead */
@@ -597,16 +609,19 @@ static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
   if (strncmp(reason, "Insufficient entries", 20) == 0 ||
       strncmp(reason, "Excessive entries", 17) == 0) {
     ry_node *s = at;
-    while (s && !count_bad(s)) s = s->parent;
-    if (!s) s = find_bad_count(c->root);
-    if (!s) return fail_at(c, at, path, "%s", reason);
+    while (s && !count_bad(s))
+      s = s->parent;
+    if (!s)
+      s = find_bad_count(c->root);
+    if (!s)
+      return fail_at(c, at, path, "%s", reason);
     const cyaml_schema_value_t *sch = s->schema;
     node_path(s, path, sizeof path);
     if (sch->type == CYAML_SEQUENCE_FIXED)
       return fail_at(c, s, path, "expected %u entries, got %u", (unsigned)sch->sequence.min, s->n);
     if (s->n < sch->sequence.min)
-      return fail_at(c, s, path, "expected at least %u entr%s, got %u",
-                     (unsigned)sch->sequence.min, sch->sequence.min == 1 ? "y" : "ies", s->n);
+      return fail_at(c, s, path, "expected at least %u entr%s, got %u", (unsigned)sch->sequence.min,
+                     sch->sequence.min == 1 ? "y" : "ies", s->n);
     return fail_at(c, s, path, "expected at most %u entries, got %u", (unsigned)sch->sequence.max,
                    s->n);
   }
@@ -617,17 +632,21 @@ static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
   const cyaml_schema_value_t *sch = at->schema;
   describe_schema(sch, want, sizeof want);
   describe_node(at, got, sizeof got);
-  if (strncmp(reason, "Expecting ", 10) == 0) return fail_at(c, at, path, "expected %s, got %s", want, got);
+  if (strncmp(reason, "Expecting ", 10) == 0)
+    return fail_at(c, at, path, "expected %s, got %s", want, got);
   const char *text = at->kind == RY_SCALAR ? at->text : arg;
-  if (strncmp(reason, "Invalid FLOAT", 13) == 0) return fail_at(c, at, path, "invalid number '%s'", text);
-  if (strncmp(reason, "FLOAT", 5) == 0) return fail_at(c, at, path, "number out of range '%s'", text);
+  if (strncmp(reason, "Invalid FLOAT", 13) == 0)
+    return fail_at(c, at, path, "invalid number '%s'", text);
+  if (strncmp(reason, "FLOAT", 5) == 0)
+    return fail_at(c, at, path, "number out of range '%s'", text);
   if (strncmp(reason, "Invalid BOOL", 12) == 0)
     return fail_at(c, at, path, "invalid boolean '%s' (true or false)", text);
   if (strncmp(reason, "Invalid ENUM", 12) == 0)
     return fail_at(c, at, path, "invalid value '%s' (%s)", text, want);
   if (strncmp(reason, "Invalid INT", 11) == 0 || strncmp(reason, "Invalid UINT", 12) == 0)
     return fail_at(c, at, path, "invalid integer '%s'", text);
-  if (strncmp(reason, "STRING length <", 15) == 0) return fail_at(c, at, path, "must not be empty");
+  if (strncmp(reason, "STRING length <", 15) == 0)
+    return fail_at(c, at, path, "must not be empty");
   if (strncmp(reason, "STRING length >", 15) == 0)
     return fail_at(c, at, path, "longer than %d characters", NAME_MAX_LEN);
   return fail_at(c, at, path, "%s", reason);
@@ -636,7 +655,8 @@ static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
 /* ---- strict scalars: libcyaml reads "1.5x" as 1.5 and any word but false/no/off as true -- */
 
 static int parse_number(const char *s, double *v) {
-  if (!s[0] || strchr(" \t\n\r\f\v", s[0])) return 0;
+  if (!s[0] || strchr(" \t\n\r\f\v", s[0]))
+    return 0;
   char *end;
   errno = 0;
   *v = strtod(s, &end);
@@ -646,8 +666,10 @@ static int parse_number(const char *s, double *v) {
 static int parse_bool(const char *s, bool *v) {
   static const char *const yes[] = {"true", "yes", "on"}, *const no[] = {"false", "no", "off"};
   for (int i = 0; i < 3; i++) {
-    if (strcasecmp(s, yes[i]) == 0) return *v = true, 1;
-    if (strcasecmp(s, no[i]) == 0) return *v = false, 1;
+    if (strcasecmp(s, yes[i]) == 0)
+      return *v = true, 1;
+    if (strcasecmp(s, no[i]) == 0)
+      return *v = false, 1;
   }
   return 0;
 }
@@ -674,7 +696,8 @@ static int check_scalars(lctx *c, const ry_node *n) {
   }
   for (unsigned i = 0; i < n->n; i++) {
     int rc = check_scalars(c, n->items[i]);
-    if (rc) return rc;
+    if (rc)
+      return rc;
   }
   return RHOD_OK;
 }
@@ -684,10 +707,12 @@ static int check_scalars(lctx *c, const ry_node *n) {
 static int apply_override(lctx *c, int k) {
   const char *ov = c->ov[k] ? c->ov[k] : "";
   const char *eq = strchr(ov, '=');
-  if (!eq || eq == ov) return fail_ov(c, k, "", "expected dotted.key=value");
+  if (!eq || eq == ov)
+    return fail_ov(c, k, "", "expected dotted.key=value");
   size_t klen = (size_t)(eq - ov);
   char key[256];
-  if (klen >= sizeof key) return fail_ov(c, k, "", "key longer than %zu characters", sizeof key - 1);
+  if (klen >= sizeof key)
+    return fail_ov(c, k, "", "key longer than %zu characters", sizeof key - 1);
   memcpy(key, ov, klen);
   key[klen] = '\0';
   const char *text = eq + 1;
@@ -695,10 +720,12 @@ static int apply_override(lctx *c, int k) {
   ry_node *val = NULL;
   ry_error ye;
   if (ry_parse(text, strlen(text), k, &val, &ye)) {
-    if (ye.oom) return fail_oom(c);
+    if (ye.oom)
+      return fail_oom(c);
     return fail_ov(c, k, key, "invalid YAML value: %s", ye.msg);
   }
-  if (!val && !(val = ry_new_scalar("", k, 1, 1))) return fail_oom(c);
+  if (!val && !(val = ry_new_scalar("", k, 1, 1)))
+    return fail_oom(c);
 
   const cyaml_schema_value_t *s = &sch_doc;
   ry_node *cur = c->root;
@@ -706,7 +733,8 @@ static int apply_override(lctx *c, int k) {
   int rc = RHOD_OK;
   for (char *seg = key, *next; seg; seg = next) {
     next = strchr(seg, '.');
-    if (next) *next++ = '\0';
+    if (next)
+      *next++ = '\0';
     size_t used = strlen(path);
     snprintf(path + used, sizeof path - used, "%s%s", used ? "." : "", seg);
     if (!seg[0]) {
@@ -731,13 +759,15 @@ static int apply_override(lctx *c, int k) {
       }
       child_schema = &f->value;
       if (!next) {
-        if (ry_map_set(cur, seg, val)) rc = fail_oom(c);
+        if (ry_map_set(cur, seg, val))
+          rc = fail_oom(c);
         val = NULL;
         break;
       }
       child = ry_map_get(cur, seg);
       if (!child && (child_schema->type == CYAML_MAPPING || is_seq_schema(child_schema))) {
-        child = ry_new(child_schema->type == CYAML_MAPPING ? RY_MAP : RY_SEQ, k, cur->line, cur->col);
+        child =
+            ry_new(child_schema->type == CYAML_MAPPING ? RY_MAP : RY_SEQ, k, cur->line, cur->col);
         if (!child || ry_map_set(cur, seg, child)) {
           ry_free(child);
           rc = fail_oom(c);
@@ -778,7 +808,8 @@ static int apply_override(lctx *c, int k) {
       }
       child = append ? NULL : cur->items[idx];
       if (!child && (child_schema->type == CYAML_MAPPING || is_seq_schema(child_schema))) {
-        child = ry_new(child_schema->type == CYAML_MAPPING ? RY_MAP : RY_SEQ, k, cur->line, cur->col);
+        child =
+            ry_new(child_schema->type == CYAML_MAPPING ? RY_MAP : RY_SEQ, k, cur->line, cur->col);
         if (!child || ry_seq_append(cur, child)) {
           ry_free(child);
           rc = fail_oom(c);
@@ -811,15 +842,17 @@ static int check_positive(lctx *c, const char *path, double v) {
 static int check_range(lctx *c, const char *path, double v, double lo, int lo_open, double hi,
                        int hi_open) {
   int ok = (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
-  if (ok) return RHOD_OK;
+  if (ok)
+    return RHOD_OK;
   return fail(c, path, "must be in %s%g, %g%s, got %g", lo_open ? "(" : "[", lo, hi,
               hi_open ? ")" : "]", v);
 }
 
-#define TRY(expr)                                                                                \
-  do {                                                                                           \
-    int rc_ = (expr);                                                                            \
-    if (rc_) return rc_;                                                                         \
+#define TRY(expr)                                                                                  \
+  do {                                                                                             \
+    int rc_ = (expr);                                                                              \
+    if (rc_)                                                                                       \
+      return rc_;                                                                                  \
   } while (0)
 
 static double opt(const double *p, double def) { return p ? *p : def; }
@@ -891,10 +924,14 @@ static int load_shape(lctx *c, const char *base, const y_rect *rect, const y_cir
   char path[128];
   const char *given[3];
   int n = 0;
-  if (rect) given[n++] = "rect";
-  if (circle) given[n++] = "circle";
-  if (poly) given[n++] = "polygon";
-  if (n == 0) return fail(c, base, "needs a shape: one of rect, circle, polygon");
+  if (rect)
+    given[n++] = "rect";
+  if (circle)
+    given[n++] = "circle";
+  if (poly)
+    given[n++] = "polygon";
+  if (n == 0)
+    return fail(c, base, "needs a shape: one of rect, circle, polygon");
   if (n > 1) {
     snprintf(path, sizeof path, "%s.%s", base, given[1]);
     return fail(c, path, "one shape per entry, but %s is also given", given[0]);
@@ -924,15 +961,18 @@ static int load_shape(lctx *c, const char *base, const y_rect *rect, const y_cir
     }
     for (unsigned i = 0; i < np; i++)
       for (unsigned j = i + 2; j < np; j++) {
-        if (i == 0 && j == np - 1) continue; /* adjacent through the closing edge */
+        if (i == 0 && j == np - 1)
+          continue; /* adjacent through the closing edge */
         if (segments_meet(poly[i], poly[i + 1], poly[j], poly[(j + 1) % np]))
           return fail(c, path, "edges %u-%u and %u-%u cross: the polygon must be simple", i, i + 1,
                       j, (j + 1) % np);
       }
     double area = polygon_area((const double(*)[2])poly, np);
-    if (area == 0) return fail(c, path, "has zero area");
+    if (area == 0)
+      return fail(c, path, "has zero area");
     out->points = malloc(np * sizeof *out->points);
-    if (!out->points) return fail_oom(c);
+    if (!out->points)
+      return fail_oom(c);
     out->n_points = np;
     for (unsigned i = 0; i < np; i++) { /* counter-clockwise */
       const double *src = area > 0 ? poly[i] : poly[np - 1 - i];
@@ -944,7 +984,8 @@ static int load_shape(lctx *c, const char *base, const y_rect *rect, const y_cir
 }
 
 static int valid_name(const char *s) {
-  if (!s[0] || s[0] == '.' || strlen(s) > NAME_MAX_LEN) return 0;
+  if (!s[0] || s[0] == '.' || strlen(s) > NAME_MAX_LEN)
+    return 0;
   return strspn(s, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") ==
          strlen(s);
 }
@@ -959,7 +1000,8 @@ static char *default_name(const char *file) {
   if (len == 5 && strncmp(base, "scene", 5) == 0 && base != file) {
     const char *end = base - 1; /* the '/' */
     const char *dir = end;
-    while (dir > file && dir[-1] != '/') dir--;
+    while (dir > file && dir[-1] != '/')
+      dir--;
     if (end > dir && !(end - dir == 1 && dir[0] == '.') && !(end - dir == 2 && dir[0] == '.')) {
       start = dir;
       len = (size_t)(end - dir);
@@ -969,16 +1011,19 @@ static char *default_name(const char *file) {
     start = "scene";
     len = 5;
   }
-  if (len > NAME_MAX_LEN) len = NAME_MAX_LEN;
+  if (len > NAME_MAX_LEN)
+    len = NAME_MAX_LEN;
   char *name = malloc(len + 1);
-  if (!name) return NULL;
+  if (!name)
+    return NULL;
   for (size_t i = 0; i < len; i++)
     name[i] = strchr("_.-", start[i]) || (start[i] >= '0' && start[i] <= '9') ||
                       (start[i] >= 'a' && start[i] <= 'z') || (start[i] >= 'A' && start[i] <= 'Z')
                   ? start[i]
                   : '_';
   name[len] = '\0';
-  if (name[0] == '.') name[0] = '_';
+  if (name[0] == '.')
+    name[0] = '_';
   return name;
 }
 
@@ -986,7 +1031,8 @@ static int inside_box(const double lo[2], const double hi[2], const double bmin[
                       const double bmax[2]) {
   for (int d = 0; d < 2; d++) {
     double tol = 1e-9 * fmax(1.0, bmax[d] - bmin[d]);
-    if (lo[d] < bmin[d] - tol || hi[d] > bmax[d] + tol) return 0;
+    if (lo[d] < bmin[d] - tol || hi[d] > bmax[d] + tol)
+      return 0;
   }
   return 1;
 }
@@ -995,11 +1041,12 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
                       size_t kpl) {
   char base[64];
   snprintf(base, sizeof base, "probes.list.%u", i);
-  const void *given[7] = {y->pressure,         y->kinetic_energy, y->potential_energy, y->front,
-                          y->mass,             y->momentum,       y->angular_momentum};
+  const void *given[7] = {y->pressure, y->kinetic_energy, y->potential_energy, y->front,
+                          y->mass,     y->momentum,       y->angular_momentum};
   int first = -1;
   for (int k = 0; k < 7; k++) {
-    if (!given[k]) continue;
+    if (!given[k])
+      continue;
     if (first >= 0) {
       char path[128];
       snprintf(path, sizeof path, "%s.%s", base, probe_kind_names[k]);
@@ -1031,7 +1078,8 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
   case RHOD_PROBE_FRONT: {
     name = y->front->name;
     double dir[2] = {1, 0};
-    if (y->front->direction) memcpy(dir, y->front->direction, sizeof dir);
+    if (y->front->direction)
+      memcpy(dir, y->front->direction, sizeof dir);
     double len = hypot(dir[0], dir[1]);
     if (!(len > 0)) {
       char path[128];
@@ -1050,10 +1098,12 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
     break;
   case RHOD_PROBE_ANGULAR_MOMENTUM:
     name = y->angular_momentum->name;
-    if (y->angular_momentum->at) memcpy(p->at, y->angular_momentum->at, sizeof p->at);
+    if (y->angular_momentum->at)
+      memcpy(p->at, y->angular_momentum->at, sizeof p->at);
     break;
   }
-  if (!name) name = probe_kind_names[first];
+  if (!name)
+    name = probe_kind_names[first];
   if (!valid_name(name)) {
     char path[160];
     snprintf(path, sizeof path, "%s.name", kind_path);
@@ -1088,21 +1138,25 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   /* particles */
   s->dx = d->particles.dx;
   s->radius_ratio = opt(d->particles.radius_ratio, 4);
-  s->kernel = d->particles.kernel ? (rhod_kernel_kind)*d->particles.kernel : RHOD_KERNEL_WENDLAND_C2;
+  s->kernel =
+      d->particles.kernel ? (rhod_kernel_kind)*d->particles.kernel : RHOD_KERNEL_WENDLAND_C2;
   TRY(check_positive(c, "particles.dx", s->dx));
   TRY(check_range(c, "particles.radius_ratio", s->radius_ratio, 2, 0, 8, 0));
   /* physics */
   s->rho0 = opt(d->physics.rho0, 1000);
   s->c0 = d->physics.c0;
   s->mu = opt(d->physics.mu, 0);
-  if (d->physics.gravity) memcpy(s->gravity, d->physics.gravity, sizeof s->gravity);
+  if (d->physics.gravity)
+    memcpy(s->gravity, d->physics.gravity, sizeof s->gravity);
   TRY(check_positive(c, "physics.rho0", s->rho0));
   TRY(check_positive(c, "physics.c0", s->c0));
-  if (!(s->mu >= 0)) return fail(c, "physics.mu", "must be >= 0, got %g", s->mu);
+  if (!(s->mu >= 0))
+    return fail(c, "physics.mu", "must be >= 0, got %g", s->mu);
   /* scheme */
   const y_scheme *sc = d->scheme;
   static const y_scheme none = {0};
-  if (!sc) sc = &none;
+  if (!sc)
+    sc = &none;
   s->riemann = opt_bool(sc->riemann, 1);
   s->reconstruction = opt_bool(sc->reconstruction, 1);
   s->shifting = opt_bool(sc->shifting, 1);
@@ -1117,7 +1171,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->shepard_threshold = opt(sc->shepard_threshold, 0.85);
   s->theta_threshold = opt(sc->theta_threshold, 0.95);
   TRY(check_positive(c, "scheme.shifting_a", s->shift_a));
-  if (!(s->shift_b >= 0)) return fail(c, "scheme.shifting_b", "must be >= 0, got %g", s->shift_b);
+  if (!(s->shift_b >= 0))
+    return fail(c, "scheme.shifting_b", "must be >= 0, got %g", s->shift_b);
   TRY(check_positive(c, "scheme.shifting_eps", s->shift_eps));
   TRY(check_positive(c, "scheme.alpha_ad", s->alpha_ad));
   for (int i = 0; i < 2; i++) {
@@ -1151,19 +1206,22 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   }
   /* fluid */
   s->fluid = calloc(d->n_fluid, sizeof *s->fluid);
-  if (!s->fluid) return fail_oom(c);
+  if (!s->fluid)
+    return fail_oom(c);
   s->n_fluid = d->n_fluid;
   for (unsigned i = 0; i < d->n_fluid; i++) {
     const y_fluid *y = &d->fluid[i];
     rhod_fluid_block *b = &s->fluid[i];
     snprintf(path, sizeof path, "fluid.%u", i);
     TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &b->shape));
-    if (y->velocity) memcpy(b->velocity, y->velocity, sizeof b->velocity);
+    if (y->velocity)
+      memcpy(b->velocity, y->velocity, sizeof b->velocity);
     b->pressure = y->pressure ? (rhod_init_kind)*y->pressure : RHOD_INIT_HYDROSTATIC;
     double lo[2], hi[2];
     shape_bbox(&b->shape, lo, hi);
     if (s->has_domain && !inside_box(lo, hi, s->domain_min, s->domain_max))
-      return fail(c, path, "lies outside the domain [%g, %g]-[%g, %g] (block spans [%g, %g]-[%g, %g])",
+      return fail(c, path,
+                  "lies outside the domain [%g, %g]-[%g, %g] (block spans [%g, %g]-[%g, %g])",
                   s->domain_min[0], s->domain_min[1], s->domain_max[0], s->domain_max[1], lo[0],
                   lo[1], hi[0], hi[1]);
     double area = shape_area(&b->shape), w = fmin(hi[0] - lo[0], hi[1] - lo[1]);
@@ -1176,7 +1234,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   /* walls */
   if (d->n_walls) {
     s->walls = calloc(d->n_walls, sizeof *s->walls);
-    if (!s->walls) return fail_oom(c);
+    if (!s->walls)
+      return fail_oom(c);
     s->n_walls = d->n_walls;
   }
   for (unsigned i = 0; i < d->n_walls; i++) {
@@ -1205,7 +1264,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   TRY(check_positive(c, "probes.every", s->probe_every));
   if (pr && pr->n_list) {
     s->probes = calloc(pr->n_list, sizeof *s->probes);
-    if (!s->probes) return fail_oom(c);
+    if (!s->probes)
+      return fail_oom(c);
     s->n_probes = pr->n_list;
   }
   for (unsigned i = 0; i < s->n_probes; i++) {
@@ -1220,6 +1280,11 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     }
     char mine[2][NAME_MAX_LEN + 3], other[2][NAME_MAX_LEN + 3];
     unsigned nm = probe_columns(&s->probes[i], mine);
+    for (unsigned a = 0; a < nm; a++)
+      if (strcmp(mine[a], "t") == 0) {
+        snprintf(path, sizeof path, "%s.name", kind_path);
+        return fail(c, path, "'t' is the time column of the probes file");
+      }
     for (unsigned j = 0; j < i; j++) {
       unsigned no = probe_columns(&s->probes[j], other);
       for (unsigned a = 0; a < nm; a++)
@@ -1255,7 +1320,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   } else {
     s->name = default_name(c->file);
   }
-  if (!s->name) return fail_oom(c);
+  if (!s->name)
+    return fail_oom(c);
   return RHOD_OK;
 }
 
@@ -1266,14 +1332,17 @@ static void fmt_num(double v, char *buf, size_t len) {
   int p = 1;
   for (; p < 17; p++) {
     snprintf(buf, len, "%.*g", p, v);
-    if (strtod(buf, NULL) == v) break;
+    if (strtod(buf, NULL) == v)
+      break;
   }
-  if (p == 17) snprintf(buf, len, "%.17g", v);
+  if (p == 17)
+    snprintf(buf, len, "%.17g", v);
   if (strchr(buf, 'e') && fabs(v) >= 1e-4 && fabs(v) < 1e15) {
     int decimals = p - 1 - (int)floor(log10(fabs(v)));
     char fixed[64];
     snprintf(fixed, sizeof fixed, "%.*f", decimals > 0 ? decimals : 0, v);
-    if (strtod(fixed, NULL) == v && strlen(fixed) < len) memcpy(buf, fixed, strlen(fixed) + 1);
+    if (strtod(fixed, NULL) == v && strlen(fixed) < len)
+      memcpy(buf, fixed, strlen(fixed) + 1);
   }
 }
 
@@ -1282,9 +1351,11 @@ typedef struct {
 } tb;
 
 static ry_node *tb_add(tb *t, ry_node *parent, const char *key, ry_node *n) {
-  if (!n) t->oom = 1;
+  if (!n)
+    t->oom = 1;
   if (t->oom || !parent) {
-    if (parent) ry_free(n);
+    if (parent)
+      ry_free(n);
     return t->oom ? NULL : n;
   }
   if (parent->kind == RY_MAP ? ry_map_set(parent, key, n) : ry_seq_append(parent, n)) {
@@ -1296,31 +1367,39 @@ static ry_node *tb_add(tb *t, ry_node *parent, const char *key, ry_node *n) {
 }
 
 static ry_node *tb_coll(tb *t, ry_node *parent, const char *key, ry_kind kind, int flow) {
-  if (t->oom) return NULL;
+  if (t->oom)
+    return NULL;
   ry_node *n = ry_new(kind, -1, 0, 0);
-  if (n) n->flow = flow;
+  if (n)
+    n->flow = flow;
   return tb_add(t, parent, key, n);
 }
 
 /* Text that YAML readers would take for a boolean, a null or a number is quoted, so that
  * e.g. slip: "no" stays a word for a Python reader of the scene as run. */
 static int looks_typed(const char *v) {
-  static const char *const words[] = {"y", "n", "yes", "no", "on", "off", "true", "false", "null", "~"};
+  static const char *const words[] = {"y",   "n",    "yes",   "no",   "on",
+                                      "off", "true", "false", "null", "~"};
   double num;
-  if (!v[0] || parse_number(v, &num)) return 1;
+  if (!v[0] || parse_number(v, &num))
+    return 1;
   for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
-    if (strcasecmp(v, words[i]) == 0) return 1;
+    if (strcasecmp(v, words[i]) == 0)
+      return 1;
   return 0;
 }
 
 static void tb_word(tb *t, ry_node *parent, const char *key, const char *v) {
-  if (t->oom) return;
+  if (t->oom)
+    return;
   ry_node *n = tb_add(t, parent, key, ry_new_scalar(v, -1, 0, 0));
-  if (n) n->quoted = looks_typed(v);
+  if (n)
+    n->quoted = looks_typed(v);
 }
 
 static void tb_str(tb *t, ry_node *parent, const char *key, const char *v) {
-  if (!t->oom) tb_add(t, parent, key, ry_new_scalar(v, -1, 0, 0));
+  if (!t->oom)
+    tb_add(t, parent, key, ry_new_scalar(v, -1, 0, 0));
 }
 
 static void tb_num(tb *t, ry_node *parent, const char *key, double v) {
@@ -1354,21 +1433,24 @@ static void tb_shape(tb *t, ry_node *entry, const rhod_shape *sh) {
     break;
   case RHOD_SHAPE_POLYGON:
     m = tb_coll(t, entry, "polygon", RY_SEQ, 1);
-    for (unsigned i = 0; i < sh->n_points; i++) tb_vec(t, m, NULL, sh->points[i]);
+    for (unsigned i = 0; i < sh->n_points; i++)
+      tb_vec(t, m, NULL, sh->points[i]);
     break;
   }
 }
 
 static const char *strval_name(const cyaml_strval_t *sv, size_t n, int v) {
   for (size_t i = 0; i < n; i++)
-    if (sv[i].val == v) return sv[i].str;
+    if (sv[i].val == v)
+      return sv[i].str;
   return "?";
 }
 
 static ry_node *scene_tree(const rhod_scene *s) {
   tb t = {0};
   ry_node *root = tb_coll(&t, NULL, NULL, RY_MAP, 0), *m, *e;
-  if (s->name) tb_word(&t, root, "name", s->name);
+  if (s->name)
+    tb_word(&t, root, "name", s->name);
   m = tb_coll(&t, root, "time", RY_MAP, 0);
   tb_num(&t, m, "end", s->t_end);
   tb_num(&t, m, "output_every", s->output_every);
@@ -1377,7 +1459,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
   m = tb_coll(&t, root, "particles", RY_MAP, 0);
   tb_num(&t, m, "dx", s->dx);
   tb_num(&t, m, "radius_ratio", s->radius_ratio);
-  tb_word(&t, m, "kernel", strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
+  tb_word(&t, m, "kernel",
+          strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
   m = tb_coll(&t, root, "physics", RY_MAP, 0);
   tb_num(&t, m, "rho0", s->rho0);
   tb_num(&t, m, "c0", s->c0);
@@ -1411,13 +1494,14 @@ static ry_node *scene_tree(const rhod_scene *s) {
     tb_shape(&t, e, &s->fluid[i].shape);
     tb_vec(&t, e, "velocity", s->fluid[i].velocity);
     tb_word(&t, e, "pressure",
-           strval_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
+            strval_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
   }
   m = tb_coll(&t, root, "walls", RY_SEQ, s->n_walls == 0);
   for (unsigned i = 0; i < s->n_walls; i++) {
     e = tb_coll(&t, m, NULL, RY_MAP, 0);
     tb_shape(&t, e, &s->walls[i].shape);
-    tb_word(&t, e, "slip", strval_name(slip_names, CYAML_ARRAY_LEN(slip_names), (int)s->walls[i].slip));
+    tb_word(&t, e, "slip",
+            strval_name(slip_names, CYAML_ARRAY_LEN(slip_names), (int)s->walls[i].slip));
     tb_bool(&t, e, "fluid_inside", s->walls[i].fluid_inside);
   }
   m = tb_coll(&t, root, "probes", RY_MAP, 0);
@@ -1428,17 +1512,20 @@ static ry_node *scene_tree(const rhod_scene *s) {
     e = tb_coll(&t, m, NULL, RY_MAP, 0);
     unsigned kind = (unsigned)p->kind < 7 ? (unsigned)p->kind : 0;
     ry_node *b = tb_coll(&t, e, probe_kind_names[kind], RY_MAP, 1);
-    if (p->name) tb_word(&t, b, "name", p->name);
+    if (p->name)
+      tb_word(&t, b, "name", p->name);
     if (p->kind == RHOD_PROBE_PRESSURE || p->kind == RHOD_PROBE_ANGULAR_MOMENTUM)
       tb_vec(&t, b, "at", p->at);
-    if (p->kind == RHOD_PROBE_FRONT) tb_vec(&t, b, "direction", p->direction);
+    if (p->kind == RHOD_PROBE_FRONT)
+      tb_vec(&t, b, "direction", p->direction);
   }
   m = tb_coll(&t, root, "output", RY_MAP, 0);
   m = tb_coll(&t, m, "picture", RY_MAP, 0);
   tb_word(&t, m, "field",
-         strval_name(field_names, CYAML_ARRAY_LEN(field_names), (int)s->picture_field));
+          strval_name(field_names, CYAML_ARRAY_LEN(field_names), (int)s->picture_field));
   tb_num(&t, m, "width", s->picture_width);
-  if (s->picture_range_set) tb_vec(&t, m, "range", s->picture_range);
+  if (s->picture_range_set)
+    tb_vec(&t, m, "range", s->picture_range);
   if (t.oom) {
     ry_free(root);
     return NULL;
@@ -1450,7 +1537,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
 
 static int read_all(const char *path, char **text, size_t *len) {
   FILE *f = fopen(path, "rb");
-  if (!f) return errno ? errno : EIO;
+  if (!f)
+    return errno ? errno : EIO;
   size_t cap = 4096, n = 0;
   char *buf = malloc(cap);
   int e = 0;
@@ -1467,12 +1555,14 @@ static int read_all(const char *path, char **text, size_t *len) {
     size_t got = fread(buf + n, 1, cap - n - 1, f);
     n += got;
     if (got == 0) {
-      if (ferror(f)) e = errno ? errno : EIO;
+      if (ferror(f))
+        e = errno ? errno : EIO;
       break;
     }
   }
   fclose(f);
-  if (!buf) return ENOMEM;
+  if (!buf)
+    return ENOMEM;
   if (e) {
     free(buf);
     return e;
@@ -1484,10 +1574,14 @@ static int read_all(const char *path, char **text, size_t *len) {
 }
 
 void rhod_scene_free(rhod_scene *s) {
-  if (!s) return;
-  for (unsigned i = 0; i < s->n_fluid; i++) free(s->fluid[i].shape.points);
-  for (unsigned i = 0; i < s->n_walls; i++) free(s->walls[i].shape.points);
-  for (unsigned i = 0; i < s->n_probes; i++) free(s->probes[i].name);
+  if (!s)
+    return;
+  for (unsigned i = 0; i < s->n_fluid; i++)
+    free(s->fluid[i].shape.points);
+  for (unsigned i = 0; i < s->n_walls; i++)
+    free(s->walls[i].shape.points);
+  for (unsigned i = 0; i < s->n_probes; i++)
+    free(s->probes[i].name);
   free(s->fluid);
   free(s->walls);
   free(s->probes);
@@ -1500,13 +1594,15 @@ void rhod_scene_free(rhod_scene *s) {
 static int load_document(lctx *c, rhod_scene **out) {
   int rc;
   for (int k = 0; k < c->n_ov; k++)
-    if ((rc = apply_override(c, k))) return rc;
+    if ((rc = apply_override(c, k)))
+      return rc;
   annotate(c->root, &sch_doc);
 
   /* the text libcyaml reads, and where each node sits in it */
   char *text = NULL;
   size_t len = 0;
-  if (ry_emit(c->root, &text, &len)) return fail_oom(c);
+  if (ry_emit(c->root, &text, &len))
+    return fail_oom(c);
   ry_node *emitted = NULL;
   ry_error ye;
   if (ry_parse(text, len, -1, &emitted, &ye)) {
@@ -1526,10 +1622,13 @@ static int load_document(lctx *c, rhod_scene **out) {
   };
   y_doc *doc = NULL;
   log.text[0] = '\0';
-  cyaml_err_t cerr = cyaml_load_data((const uint8_t *)text, len, &cfg, &sch_doc, (void **)&doc, NULL);
+  cyaml_err_t cerr =
+      cyaml_load_data((const uint8_t *)text, len, &cfg, &sch_doc, (void **)&doc, NULL);
   free(text);
-  if (cerr != CYAML_OK) return cyaml_failure(c, cerr, &log);
-  if (!doc) return fail_at(c, c->root, "time", "missing required key");
+  if (cerr != CYAML_OK)
+    return cyaml_failure(c, cerr, &log);
+  if (!doc)
+    return fail_at(c, c->root, "time", "missing required key");
 
   rc = check_scalars(c, c->root);
   rhod_scene *s = NULL;
@@ -1541,7 +1640,8 @@ static int load_document(lctx *c, rhod_scene **out) {
   if (!rc) {
     ry_node *tree = scene_tree(s);
     s->path = strdup(c->file);
-    if (!tree || !s->path || ry_emit(tree, &s->yaml, NULL)) rc = fail_oom(c);
+    if (!tree || !s->path || ry_emit(tree, &s->yaml, NULL))
+      rc = fail_oom(c);
     ry_free(tree);
   }
   if (rc) {
@@ -1554,8 +1654,10 @@ static int load_document(lctx *c, rhod_scene **out) {
 
 int rhod_scene_load(const char *path, const char *const *overrides, int n_overrides,
                     rhod_scene **out, char *err, size_t errlen) {
-  if (err && errlen) err[0] = '\0';
-  if (!out) return RHOD_ERR_USAGE;
+  if (err && errlen)
+    err[0] = '\0';
+  if (!out)
+    return RHOD_ERR_USAGE;
   *out = NULL;
   lctx c = {
       .file = path ? path : "(no file)",
@@ -1572,7 +1674,8 @@ int rhod_scene_load(const char *path, const char *const *overrides, int n_overri
   size_t len = 0;
   int e = read_all(path, &text, &len);
   if (e) {
-    if (e == ENOMEM) return fail_oom(&c);
+    if (e == ENOMEM)
+      return fail_oom(&c);
     put_msg(&c, "%s: cannot read: %s", path, strerror(e));
     return RHOD_ERR_READ;
   }
@@ -1597,9 +1700,11 @@ int rhod_scene_load(const char *path, const char *const *overrides, int n_overri
 /* ---- parameters ------------------------------------------------------------------------- */
 
 static int inline_only(const ry_node *n) {
-  if (n->kind == RY_MAP) return 0;
+  if (n->kind == RY_MAP)
+    return 0;
   for (unsigned i = 0; i < n->n; i++)
-    if (!inline_only(n->items[i])) return 0;
+    if (!inline_only(n->items[i]))
+      return 0;
   return 1;
 }
 
@@ -1610,7 +1715,8 @@ static void inline_text(const ry_node *n, char *buf, size_t len, size_t *used) {
   }
   *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "[");
   for (unsigned i = 0; i < n->n; i++) {
-    if (i) *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, ", ");
+    if (i)
+      *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, ", ");
     inline_text(n->items[i], buf, len, used);
   }
   *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "]");
@@ -1620,10 +1726,12 @@ static int param_push(rhod_param_list *p, unsigned *cap, const char *key, const 
   if (p->n == *cap) {
     unsigned nc = *cap ? 2 * *cap : 64;
     char **k = realloc(p->keys, nc * sizeof *k);
-    if (!k) return -1;
+    if (!k)
+      return -1;
     p->keys = k;
     char **v = realloc(p->values, nc * sizeof *v);
-    if (!v) return -1;
+    if (!v)
+      return -1;
     p->values = v;
     *cap = nc;
   }
@@ -1639,39 +1747,48 @@ static int param_push(rhod_param_list *p, unsigned *cap, const char *key, const 
 }
 
 static int flatten(const ry_node *n, const char *path, rhod_param_list *p, unsigned *cap) {
-  if (n->kind == RY_SCALAR) return param_push(p, cap, path, n->text);
+  if (n->kind == RY_SCALAR)
+    return param_push(p, cap, path, n->text);
   if (n->kind == RY_SEQ && inline_only(n)) {
     size_t used = 0;
     inline_text(n, NULL, 0, &used);
     char *buf = malloc(used + 1);
-    if (!buf) return -1;
+    if (!buf)
+      return -1;
     used = 0;
     inline_text(n, buf, SIZE_MAX, &used);
     int rc = param_push(p, cap, path, buf);
     free(buf);
     return rc;
   }
-  if (n->kind == RY_MAP && n->n == 0) return param_push(p, cap, path, "{}");
+  if (n->kind == RY_MAP && n->n == 0)
+    return param_push(p, cap, path, "{}");
   for (unsigned i = 0; i < n->n; i++) {
     char idx[16];
-    const char *seg = n->kind == RY_MAP ? n->keys[i]->text : (snprintf(idx, sizeof idx, "%u", i), idx);
+    const char *seg =
+        n->kind == RY_MAP ? n->keys[i]->text : (snprintf(idx, sizeof idx, "%u", i), idx);
     size_t len = strlen(path) + strlen(seg) + 2;
     char *child = malloc(len);
-    if (!child) return -1;
+    if (!child)
+      return -1;
     snprintf(child, len, "%s%s%s", path, path[0] ? "." : "", seg);
     int rc = flatten(n->items[i], child, p, cap);
     free(child);
-    if (rc) return rc;
+    if (rc)
+      return rc;
   }
   return 0;
 }
 
 int rhod_scene_params(const rhod_scene *s, rhod_param_list *out) {
-  if (!out) return RHOD_ERR_USAGE;
+  if (!out)
+    return RHOD_ERR_USAGE;
   memset(out, 0, sizeof *out);
-  if (!s) return RHOD_ERR_USAGE;
+  if (!s)
+    return RHOD_ERR_USAGE;
   ry_node *tree = scene_tree(s);
-  if (!tree) return RHOD_ERR_MEMORY;
+  if (!tree)
+    return RHOD_ERR_MEMORY;
   unsigned cap = 0;
   int rc = flatten(tree, "", out, &cap);
   ry_free(tree);
@@ -1683,7 +1800,8 @@ int rhod_scene_params(const rhod_scene *s, rhod_param_list *out) {
 }
 
 void rhod_param_list_free(rhod_param_list *p) {
-  if (!p) return;
+  if (!p)
+    return;
   for (unsigned i = 0; i < p->n; i++) {
     free(p->keys[i]);
     free(p->values[i]);
@@ -1710,8 +1828,10 @@ static void warn(warn_buf *w, const char *fmt, ...) {
       va_start(ap, fmt);
       int n = vsnprintf(w->buf + w->used, w->len - w->used, fmt, ap);
       va_end(ap);
-      if (n > 0) w->used += (size_t)n;
-      if (w->used >= w->len) w->used = w->len - 1;
+      if (n > 0)
+        w->used += (size_t)n;
+      if (w->used >= w->len)
+        w->used = w->len - 1;
     }
   }
   w->count++;
@@ -1751,8 +1871,10 @@ static void fluid_extent(const rhod_scene *s, const double e[2], double *lo, dou
 
 int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
   warn_buf w = {buf, len, 0, 0};
-  if (buf && len) buf[0] = '\0';
-  if (!s) return 0;
+  if (buf && len)
+    buf[0] = '\0';
+  if (!s)
+    return 0;
   const char *file = s->path ? s->path : "(scene)";
 
   /* Eq. 2 of paper 002 */
@@ -1774,14 +1896,17 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
          file, s->c0, bound, du, dp, H);
 
   if (s->output_every > s->t_end)
-    warn(&w, "%s: time.output_every: %g s exceeds time.end = %g s: only the initial state is written",
+    warn(&w,
+         "%s: time.output_every: %g s exceeds time.end = %g s: only the initial state is written",
          file, s->output_every, s->t_end);
 
   if (s->picture_range_set && s->picture_field == RHOD_FIELD_FREE_SURFACE)
-    warn(&w, "%s: output.picture.range: ignored for field free_surface (a flag, not a scale)", file);
+    warn(&w, "%s: output.picture.range: ignored for field free_surface (a flag, not a scale)",
+         file);
 
   for (int a = 0; a < 2; a++) {
-    if (!s->periodic[a] || !(s->dx > 0)) continue;
+    if (!s->periodic[a] || !(s->dx > 0))
+      continue;
     double L = s->domain_max[a] - s->domain_min[a], n = L / s->dx;
     if (fabs(n - nearbyint(n)) > 1e-6 * fmax(1, n))
       warn(&w,

@@ -15,7 +15,8 @@ enum { RY_MAX_DEPTH = 64, RY_MAX_NODES = 1000000 };
 
 ry_node *ry_new(ry_kind kind, int origin, unsigned line, unsigned col) {
   ry_node *n = calloc(1, sizeof *n);
-  if (!n) return NULL;
+  if (!n)
+    return NULL;
   n->kind = kind;
   n->origin = origin;
   n->line = line;
@@ -25,7 +26,8 @@ ry_node *ry_new(ry_kind kind, int origin, unsigned line, unsigned col) {
 
 ry_node *ry_new_scalar(const char *text, int origin, unsigned line, unsigned col) {
   ry_node *n = ry_new(RY_SCALAR, origin, line, col);
-  if (!n) return NULL;
+  if (!n)
+    return NULL;
   n->text = strdup(text ? text : "");
   if (!n->text) {
     free(n);
@@ -35,10 +37,12 @@ ry_node *ry_new_scalar(const char *text, int origin, unsigned line, unsigned col
 }
 
 void ry_free(ry_node *n) {
-  if (!n) return;
+  if (!n)
+    return;
   for (unsigned i = 0; i < n->n; i++) {
     ry_free(n->items[i]);
-    if (n->keys) ry_free(n->keys[i]);
+    if (n->keys)
+      ry_free(n->keys[i]);
   }
   free(n->items);
   free(n->keys);
@@ -47,14 +51,17 @@ void ry_free(ry_node *n) {
 }
 
 static int grow(ry_node *c) {
-  if (c->n < c->cap) return 0;
+  if (c->n < c->cap)
+    return 0;
   unsigned cap = c->cap ? 2 * c->cap : 4;
   ry_node **items = realloc(c->items, cap * sizeof *items);
-  if (!items) return -1;
+  if (!items)
+    return -1;
   c->items = items;
   if (c->kind == RY_MAP) {
     ry_node **keys = realloc(c->keys, cap * sizeof *keys);
-    if (!keys) return -1;
+    if (!keys)
+      return -1;
     c->keys = keys;
   }
   c->cap = cap;
@@ -62,7 +69,8 @@ static int grow(ry_node *c) {
 }
 
 int ry_seq_append(ry_node *seq, ry_node *value) {
-  if (grow(seq)) return -1;
+  if (grow(seq))
+    return -1;
   value->parent = seq;
   value->index = seq->n;
   seq->items[seq->n++] = value;
@@ -70,7 +78,8 @@ int ry_seq_append(ry_node *seq, ry_node *value) {
 }
 
 static int map_append(ry_node *map, ry_node *key, ry_node *value) {
-  if (grow(map)) return -1;
+  if (grow(map))
+    return -1;
   key->parent = value->parent = map;
   key->index = value->index = map->n;
   key->is_key = 1;
@@ -80,9 +89,11 @@ static int map_append(ry_node *map, ry_node *key, ry_node *value) {
 }
 
 ry_node *ry_map_key(const ry_node *map, const char *key) {
-  if (!map || map->kind != RY_MAP) return NULL;
+  if (!map || map->kind != RY_MAP)
+    return NULL;
   for (unsigned i = 0; i < map->n; i++)
-    if (strcmp(map->keys[i]->text, key) == 0) return map->keys[i];
+    if (strcmp(map->keys[i]->text, key) == 0)
+      return map->keys[i];
   return NULL;
 }
 
@@ -95,7 +106,8 @@ void ry_replace(ry_node *old, ry_node *value) {
   ry_node *p = old->parent;
   value->parent = p;
   value->index = old->index;
-  if (p) p->items[old->index] = value;
+  if (p)
+    p->items[old->index] = value;
   ry_free(old);
 }
 
@@ -106,7 +118,8 @@ int ry_map_set(ry_node *map, const char *key, ry_node *value) {
     return 0;
   }
   ry_node *k = ry_new_scalar(key, value->origin, value->line, value->col);
-  if (!k) return -1;
+  if (!k)
+    return -1;
   if (map_append(map, k, value)) {
     ry_free(k);
     return -1;
@@ -118,7 +131,8 @@ int ry_map_set(ry_node *map, const char *key, ry_node *value) {
 
 static void path_append(char *buf, size_t len, const char *fmt, ...) {
   size_t used = strlen(buf);
-  if (used + 1 >= len) return;
+  if (used + 1 >= len)
+    return;
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(buf + used, len - used, fmt, ap);
@@ -127,7 +141,8 @@ static void path_append(char *buf, size_t len, const char *fmt, ...) {
 
 static void path_rec(const ry_node *n, char *buf, size_t len) {
   const ry_node *p = n->parent;
-  if (!p) return;
+  if (!p)
+    return;
   path_rec(p, buf, len);
   const char *dot = buf[0] ? "." : "";
   if (p->kind == RY_MAP)
@@ -137,9 +152,11 @@ static void path_rec(const ry_node *n, char *buf, size_t len) {
 }
 
 void ry_path(const ry_node *n, char *buf, size_t len) {
-  if (!len) return;
+  if (!len)
+    return;
   buf[0] = '\0';
-  if (n) path_rec(n, buf, len);
+  if (n)
+    path_rec(n, buf, len);
 }
 
 ry_node *ry_find_path(ry_node *root, const char *path) {
@@ -157,12 +174,15 @@ ry_node *ry_find_path(ry_node *root, const char *path) {
         }
     } else if (n->kind == RY_SEQ && seg > 0 && seg < 10 && strspn(s, "0123456789") >= seg) {
       unsigned long i = strtoul(s, NULL, 10);
-      if (i < n->n) next = n->items[i];
+      if (i < n->n)
+        next = n->items[i];
     }
-    if (!next) break;
+    if (!next)
+      break;
     n = next;
     s += seg;
-    if (*s == '.') s++;
+    if (*s == '.')
+      s++;
   }
   return n;
 }
@@ -216,17 +236,20 @@ static void set_oom(builder *b) {
 }
 
 static ry_node *copy_tree(builder *b, const ry_node *src) {
-  if (++b->count > RY_MAX_NODES) return NULL;
+  if (++b->count > RY_MAX_NODES)
+    return NULL;
   ry_node *n = src->kind == RY_SCALAR ? ry_new_scalar(src->text, b->origin, src->line, src->col)
                                       : ry_new(src->kind, b->origin, src->line, src->col);
-  if (!n) return NULL;
+  if (!n)
+    return NULL;
   n->quoted = src->quoted;
   n->flow = src->flow;
   for (unsigned i = 0; i < src->n; i++) {
     ry_node *v = copy_tree(b, src->items[i]);
     ry_node *k = src->kind == RY_MAP && v ? copy_tree(b, src->keys[i]) : NULL;
     int bad = !v || (src->kind == RY_MAP && !k);
-    if (!bad) bad = src->kind == RY_MAP ? map_append(n, k, v) : ry_seq_append(n, v);
+    if (!bad)
+      bad = src->kind == RY_MAP ? map_append(n, k, v) : ry_seq_append(n, v);
     if (bad) {
       ry_free(v);
       ry_free(k);
@@ -280,16 +303,19 @@ static int attach(builder *b, ry_node *node) {
 }
 
 static int add_anchor(builder *b, const yaml_char_t *name, ry_node *node) {
-  if (!name) return 0;
+  if (!name)
+    return 0;
   if (b->n_anchors == b->cap_anchors) {
     unsigned cap = b->cap_anchors ? 2 * b->cap_anchors : 8;
     anchor *a = realloc(b->anchors, cap * sizeof *a);
-    if (!a) return -1;
+    if (!a)
+      return -1;
     b->anchors = a;
     b->cap_anchors = cap;
   }
   char *copy = strdup((const char *)name);
-  if (!copy) return -1;
+  if (!copy)
+    return -1;
   b->anchors[b->n_anchors].name = copy;
   b->anchors[b->n_anchors].node = node;
   b->n_anchors++;
@@ -319,17 +345,20 @@ static int on_event(builder *b, const yaml_event_t *ev) {
         node = NULL;
       }
     }
-    if (node) node->quoted = ev->data.scalar.style != YAML_PLAIN_SCALAR_STYLE;
+    if (node)
+      node->quoted = ev->data.scalar.style != YAML_PLAIN_SCALAR_STYLE;
     anchor_name = ev->data.scalar.anchor;
     break;
   case YAML_SEQUENCE_START_EVENT:
     node = ry_new(RY_SEQ, b->origin, line, col);
-    if (node) node->flow = ev->data.sequence_start.style == YAML_FLOW_SEQUENCE_STYLE;
+    if (node)
+      node->flow = ev->data.sequence_start.style == YAML_FLOW_SEQUENCE_STYLE;
     anchor_name = ev->data.sequence_start.anchor;
     break;
   case YAML_MAPPING_START_EVENT:
     node = ry_new(RY_MAP, b->origin, line, col);
-    if (node) node->flow = ev->data.mapping_start.style == YAML_FLOW_MAPPING_STYLE;
+    if (node)
+      node->flow = ev->data.mapping_start.style == YAML_FLOW_MAPPING_STYLE;
     anchor_name = ev->data.mapping_start.anchor;
     break;
   case YAML_ALIAS_EVENT: {
@@ -376,7 +405,8 @@ static int on_event(builder *b, const yaml_event_t *ev) {
     set_oom(b);
     return -1;
   }
-  if (attach(b, node)) return -1;
+  if (attach(b, node))
+    return -1;
   if (ev->type == YAML_SEQUENCE_START_EVENT || ev->type == YAML_MAPPING_START_EVENT) {
     if (b->depth == RY_MAX_DEPTH) {
       set_error(b, line, col, "nested deeper than %d levels", RY_MAX_DEPTH);
@@ -426,7 +456,8 @@ int ry_parse(const char *text, size_t len, int origin, ry_node **root, ry_error 
     yaml_event_t ev;
     if (!yaml_parser_parse(&p, &ev)) {
       unsigned line = (unsigned)p.problem_mark.line + 1, col = (unsigned)p.problem_mark.column + 1;
-      if (p.error == YAML_READER_ERROR) offset_to_mark(text, len, p.problem_offset, &line, &col);
+      if (p.error == YAML_READER_ERROR)
+        offset_to_mark(text, len, p.problem_offset, &line, &col);
       if (p.error == YAML_MEMORY_ERROR)
         set_oom(b);
       else if (p.context)
@@ -438,14 +469,18 @@ int ry_parse(const char *text, size_t len, int origin, ry_node **root, ry_error 
       break;
     }
     int done = ev.type == YAML_STREAM_END_EVENT;
-    if (on_event(b, &ev)) rc = -1;
+    if (on_event(b, &ev))
+      rc = -1;
     yaml_event_delete(&ev);
-    if (rc || done) break;
+    if (rc || done)
+      break;
   }
   yaml_parser_delete(&p);
   /* pending keys of unfinished mappings are not in the tree yet */
-  for (unsigned i = 0; i < b->depth; i++) ry_free(b->st[i].pending_key);
-  for (unsigned i = 0; i < b->n_anchors; i++) free(b->anchors[i].name);
+  for (unsigned i = 0; i < b->depth; i++)
+    ry_free(b->st[i].pending_key);
+  for (unsigned i = 0; i < b->n_anchors; i++)
+    free(b->anchors[i].name);
   free(b->anchors);
   if (rc)
     ry_free(b->root);
@@ -466,9 +501,11 @@ static int write_handler(void *data, unsigned char *buffer, size_t size) {
   sbuf *s = data;
   if (s->len + size + 1 > s->cap) {
     size_t cap = s->cap ? s->cap : 1024;
-    while (cap < s->len + size + 1) cap *= 2;
+    while (cap < s->len + size + 1)
+      cap *= 2;
     char *nb = realloc(s->buf, cap);
-    if (!nb) return 0;
+    if (!nb)
+      return 0;
     s->buf = nb;
     s->cap = cap;
   }
@@ -498,8 +535,10 @@ static int emit_node(yaml_emitter_t *em, const ry_node *n) {
         !yaml_emitter_emit(em, &ev))
       return -1;
     for (unsigned i = 0; i < n->n; i++)
-      if (emit_node(em, n->items[i])) return -1;
-    if (!yaml_sequence_end_event_initialize(&ev) || !yaml_emitter_emit(em, &ev)) return -1;
+      if (emit_node(em, n->items[i]))
+        return -1;
+    if (!yaml_sequence_end_event_initialize(&ev) || !yaml_emitter_emit(em, &ev))
+      return -1;
     return 0;
   case RY_MAP:
     if (!yaml_mapping_start_event_initialize(
@@ -509,7 +548,8 @@ static int emit_node(yaml_emitter_t *em, const ry_node *n) {
     for (unsigned i = 0; i < n->n; i++)
       if (emit_scalar(em, n->keys[i]->text, n->keys[i]->quoted) || emit_node(em, n->items[i]))
         return -1;
-    if (!yaml_mapping_end_event_initialize(&ev) || !yaml_emitter_emit(em, &ev)) return -1;
+    if (!yaml_mapping_end_event_initialize(&ev) || !yaml_emitter_emit(em, &ev))
+      return -1;
     return 0;
   }
   return -1;
@@ -517,9 +557,11 @@ static int emit_node(yaml_emitter_t *em, const ry_node *n) {
 
 int ry_emit(const ry_node *root, char **out, size_t *len) {
   *out = NULL;
-  if (len) *len = 0;
+  if (len)
+    *len = 0;
   yaml_emitter_t em;
-  if (!yaml_emitter_initialize(&em)) return -1;
+  if (!yaml_emitter_initialize(&em))
+    return -1;
   sbuf s = {0};
   yaml_emitter_set_output(&em, write_handler, &s);
   yaml_emitter_set_unicode(&em, 1);
@@ -533,10 +575,14 @@ int ry_emit(const ry_node *root, char **out, size_t *len) {
   if (!yaml_document_start_event_initialize(&ev, NULL, NULL, NULL, 1) ||
       !yaml_emitter_emit(&em, &ev))
     goto done;
-  if (emit_node(&em, root ? root : &empty)) goto done;
-  if (!yaml_document_end_event_initialize(&ev, 1) || !yaml_emitter_emit(&em, &ev)) goto done;
-  if (!yaml_stream_end_event_initialize(&ev) || !yaml_emitter_emit(&em, &ev)) goto done;
-  if (!yaml_emitter_flush(&em)) goto done;
+  if (emit_node(&em, root ? root : &empty))
+    goto done;
+  if (!yaml_document_end_event_initialize(&ev, 1) || !yaml_emitter_emit(&em, &ev))
+    goto done;
+  if (!yaml_stream_end_event_initialize(&ev) || !yaml_emitter_emit(&em, &ev))
+    goto done;
+  if (!yaml_emitter_flush(&em))
+    goto done;
   rc = 0;
 done:
   yaml_emitter_delete(&em);
@@ -545,14 +591,16 @@ done:
     return -1;
   }
   *out = s.buf;
-  if (len) *len = s.len;
+  if (len)
+    *len = s.len;
   return 0;
 }
 
 /* ---- positions in the emitted text ---------------------------------------------------- */
 
 void ry_set_emitted_marks(ry_node *n, const ry_node *emitted) {
-  if (!n || !emitted) return;
+  if (!n || !emitted)
+    return;
   n->eline = emitted->line;
   n->ecol = emitted->col;
   for (unsigned i = 0; i < n->n && i < emitted->n; i++) {
@@ -574,23 +622,29 @@ static int mark_le(unsigned l1, unsigned c1, unsigned l2, unsigned c2) {
 static void find_rec(ry_node *n, find_state *f) {
   if (n->eline == f->line && n->ecol == f->col) {
     if (n->is_key) {
-      if (!f->exact_key) f->exact_key = n;
+      if (!f->exact_key)
+        f->exact_key = n;
     } else if (!f->exact_value) {
       f->exact_value = n;
     }
   }
-  if (!n->is_key && mark_le(n->eline, n->ecol, f->line, f->col)) f->before = n;
+  if (!n->is_key && mark_le(n->eline, n->ecol, f->line, f->col))
+    f->before = n;
   for (unsigned i = 0; i < n->n; i++) {
-    if (n->kind == RY_MAP) find_rec(n->keys[i], f);
+    if (n->kind == RY_MAP)
+      find_rec(n->keys[i], f);
     find_rec(n->items[i], f);
   }
 }
 
 ry_node *ry_find_emitted(ry_node *root, unsigned line, unsigned col) {
-  if (!root) return NULL;
+  if (!root)
+    return NULL;
   find_state f = {line, col, NULL, NULL, NULL};
   find_rec(root, &f);
-  if (f.exact_value) return f.exact_value;
-  if (f.exact_key) return f.exact_key;
+  if (f.exact_value)
+    return f.exact_value;
+  if (f.exact_key)
+    return f.exact_key;
   return f.before ? f.before : root;
 }

@@ -12,18 +12,18 @@ typedef enum { RY_SCALAR = 0, RY_SEQ, RY_MAP } ry_kind;
 typedef struct ry_node ry_node;
 struct ry_node {
   ry_kind kind;
-  char *text;            /* RY_SCALAR and key nodes: the value, NUL-terminated */
-  int quoted;            /* RY_SCALAR: written quoted or as a block scalar, not plain */
-  int flow;              /* RY_SEQ, RY_MAP: flow style ([...], {...}) */
-  int is_key;            /* a mapping key (a scalar); index is its pair */
-  int origin;            /* -1: the scene file; k >= 0: override number k */
-  unsigned line, col;    /* 1-based start position in the text it was parsed from */
-  unsigned eline, ecol;  /* 1-based start position in the text handed to libcyaml */
-  const void *schema;    /* the libcyaml schema value it was matched to, or NULL */
+  char *text;           /* RY_SCALAR and key nodes: the value, NUL-terminated */
+  int quoted;           /* RY_SCALAR: written quoted or as a block scalar, not plain */
+  int flow;             /* RY_SEQ, RY_MAP: flow style ([...], {...}) */
+  int is_key;           /* a mapping key (a scalar); index is its pair */
+  int origin;           /* -1: the scene file; k >= 0: override number k */
+  unsigned line, col;   /* 1-based start position in the text it was parsed from */
+  unsigned eline, ecol; /* 1-based start position in the text handed to libcyaml */
+  const void *schema;   /* the libcyaml schema value it was matched to, or NULL */
   ry_node *parent;
-  unsigned index;        /* position in the parent's items (or keys) */
-  ry_node **items;       /* RY_SEQ: entries; RY_MAP: values */
-  ry_node **keys;        /* RY_MAP: key scalars, parallel to items */
+  unsigned index;  /* position in the parent's items (or keys) */
+  ry_node **items; /* RY_SEQ: entries; RY_MAP: values */
+  ry_node **keys;  /* RY_MAP: key scalars, parallel to items */
   unsigned n, cap;
 };
 

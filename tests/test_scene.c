@@ -21,7 +21,8 @@ static rhod_scene *load_ok(const char *path, const char *const *ov, int n) {
   char err[1024] = "";
   rhod_scene *s = NULL;
   int rc = rhod_scene_load(path, ov, n, &s, err, sizeof err);
-  if (rc != RHOD_OK) fprintf(stderr, "\nunexpected failure: %s\n", err);
+  if (rc != RHOD_OK)
+    fprintf(stderr, "\nunexpected failure: %s\n", err);
   CU_ASSERT_EQUAL(rc, RHOD_OK);
   CU_ASSERT_PTR_NOT_NULL(s);
   return s;
@@ -31,7 +32,8 @@ static rhod_scene *load_ok(const char *path, const char *const *ov, int n) {
 
 static void test_full_scene(void) {
   rhod_scene *s = load_ok(GOOD("full.yaml"), NULL, 0);
-  if (!s) return;
+  if (!s)
+    return;
   CU_ASSERT_STRING_EQUAL(s->name, "full_scene");
   CU_ASSERT_STRING_EQUAL(s->path, GOOD("full.yaml"));
   CLOSE(s->t_end, 1.0);
@@ -117,7 +119,8 @@ static void test_full_scene(void) {
 
 static void test_defaults(void) {
   rhod_scene *s = load_ok(GOOD("minimal.yaml"), NULL, 0);
-  if (!s) return;
+  if (!s)
+    return;
   CU_ASSERT_STRING_EQUAL(s->name, "minimal"); /* from the file name */
   CLOSE(s->cfl, 0.5);
   CLOSE(s->cfl_visc, 0.025);
@@ -161,7 +164,8 @@ static void test_defaults(void) {
 
 static void test_anchors(void) {
   rhod_scene *s = load_ok(GOOD("anchors.yaml"), NULL, 0);
-  if (!s) return;
+  if (!s)
+    return;
   CU_ASSERT_EQUAL(s->n_fluid, 2);
   CU_ASSERT_EQUAL_FATAL(s->n_walls, 3);
   CLOSE(s->walls[1].shape.max[0], 1);
@@ -178,17 +182,18 @@ static void test_overrides(void) {
       "particles.dx=0.005",
       "physics.gravity=[0,-1]",
       "fluid.0.velocity=[1,0]",
-      "time.cfl=0.3",               /* a key the file does not have */
-      "output.picture.width=1024",  /* a mapping the file does not have */
-      "physics.gravity.0=0.25",     /* one entry of a vector */
+      "time.cfl=0.3",                                         /* a key the file does not have */
+      "output.picture.width=1024",                            /* a mapping the file does not have */
+      "physics.gravity.0=0.25",                               /* one entry of a vector */
       "fluid.1={circle: {center: [0.5, 0.25], radius: 0.1}}", /* appended block */
-      "probes.list.0.front.name=X", /* built from nothing */
+      "probes.list.0.front.name=X",                           /* built from nothing */
       "scheme.riemann=false",
       "name=renamed",
   };
   int n = (int)(sizeof ov / sizeof ov[0]);
   rhod_scene *s = load_ok(GOOD("minimal.yaml"), ov, n);
-  if (!s) return;
+  if (!s)
+    return;
   CLOSE(s->t_end, 0.5);
   CLOSE(s->dx, 0.005);
   CLOSE(s->gravity[0], 0.25);
@@ -213,7 +218,8 @@ static void test_overrides(void) {
   /* later overrides win */
   const char *twice[] = {"time.end=2", "time.end=3"};
   s = load_ok(GOOD("minimal.yaml"), twice, 2);
-  if (s) CLOSE(s->t_end, 3);
+  if (s)
+    CLOSE(s->t_end, 3);
   rhod_scene_free(s);
 }
 
@@ -234,6 +240,8 @@ static const struct {
     {"fluid.x.velocity=[1,0]", "fluid.x", "list index"},
     {"fluid.0.rect.max=[-1,1]", "fluid.0.rect.max", "must exceed rect.min"},
     {"time=3", "time", "expected a mapping, got '3'"},
+    {"probes.list.0.mass.name=t", "probes.list.0.mass.name", "time column"},
+    {"name=two words", "name", "not a valid name"},
     {"physics.gravity=[0,", "physics.gravity", "invalid YAML value"},
     {"time.end", "(top level)", "expected dotted.key=value"},
     {"=1", "(top level)", "expected dotted.key=value"},
@@ -248,7 +256,8 @@ static void test_override_errors(void) {
     snprintf(want, sizeof want, "--set %s: %s: ", bad_overrides[i].set, bad_overrides[i].key);
     int ok = rc == RHOD_ERR_SCENE && s == NULL && strncmp(err, want, strlen(want)) == 0 &&
              strstr(err, bad_overrides[i].reason);
-    if (!ok) fprintf(stderr, "\n--set %s: rc %d, message '%s'\n", bad_overrides[i].set, rc, err);
+    if (!ok)
+      fprintf(stderr, "\n--set %s: rc %d, message '%s'\n", bad_overrides[i].set, rc, err);
     CU_ASSERT_TRUE(ok);
     CU_ASSERT_PTR_NULL(strchr(err, '\n'));
   }
@@ -345,7 +354,8 @@ static void test_unreadable(void) {
   int rc = rhod_scene_load(BAD("does_not_exist.yaml"), NULL, 0, &s, err, sizeof err);
   CU_ASSERT_EQUAL(rc, RHOD_ERR_READ);
   CU_ASSERT_PTR_NULL(s);
-  CU_ASSERT_STRING_EQUAL(err, BAD("does_not_exist.yaml") ": cannot read: No such file or directory");
+  CU_ASSERT_STRING_EQUAL(err,
+                         BAD("does_not_exist.yaml") ": cannot read: No such file or directory");
   rc = rhod_scene_load(RHOD_SOURCE_DIR "/tests/scenes", NULL, 0, &s, err, sizeof err);
   CU_ASSERT_EQUAL(rc, RHOD_ERR_READ);
   CU_ASSERT_PTR_NOT_NULL(strstr(err, "/tests/scenes: cannot read: "));
@@ -361,7 +371,8 @@ static void test_unreadable(void) {
 static void test_as_run_round_trip(void) {
   const char *ov[] = {"physics.c0=90"};
   rhod_scene *a = load_ok(GOOD("full.yaml"), ov, 1);
-  if (!a) return;
+  if (!a)
+    return;
   const char *tmp = "test_scene_as_run.yaml";
   FILE *f = fopen(tmp, "w");
   CU_ASSERT_PTR_NOT_NULL_FATAL(f);
@@ -381,19 +392,22 @@ static void test_as_run_round_trip(void) {
   rhod_scene_free(b);
   /* no domain given: none written, so the default stays the bounding box */
   a = load_ok(GOOD("minimal.yaml"), NULL, 0);
-  if (a) CU_ASSERT_PTR_NULL(strstr(a->yaml, "min: [0, 0]\n  max"));
+  if (a)
+    CU_ASSERT_PTR_NULL(strstr(a->yaml, "min: [0, 0]\n  max"));
   rhod_scene_free(a);
 }
 
 static const char *param(const rhod_param_list *p, const char *key) {
   for (unsigned i = 0; i < p->n; i++)
-    if (strcmp(p->keys[i], key) == 0) return p->values[i];
+    if (strcmp(p->keys[i], key) == 0)
+      return p->values[i];
   return NULL;
 }
 
 static void test_params(void) {
   rhod_scene *s = load_ok(GOOD("full.yaml"), NULL, 0);
-  if (!s) return;
+  if (!s)
+    return;
   rhod_param_list p;
   CU_ASSERT_EQUAL_FATAL(rhod_scene_params(s, &p), RHOD_OK);
   const struct {
@@ -478,17 +492,19 @@ static void test_c0_warning(void) {
   /* without gravity the bound is 10 max|u0| */
   const char *ov_u[] = {"fluid.0.velocity=[3,4]", "physics.c0=49"};
   s = load_ok(GOOD("minimal.yaml"), ov_u, 2);
-  if (s) CU_ASSERT_EQUAL(rhod_scene_warnings(s, buf, sizeof buf), 1);
+  if (s)
+    CU_ASSERT_EQUAL(rhod_scene_warnings(s, buf, sizeof buf), 1);
   rhod_scene_free(s);
 }
 
 static void test_other_warnings(void) {
-  const char *ov[] = {"time.output_every=2", "output.picture.field=free_surface",
-                      "output.picture.range=[0,1]", "domain.min=[0,0]", "domain.max=[1.005,1]",
-                      "domain.periodic=[true,false]"};
+  const char *ov[] = {"time.output_every=2",        "output.picture.field=free_surface",
+                      "output.picture.range=[0,1]", "domain.min=[0,0]",
+                      "domain.max=[1.005,1]",       "domain.periodic=[true,false]"};
   char buf[4096];
   rhod_scene *s = load_ok(GOOD("minimal.yaml"), ov, 6);
-  if (!s) return;
+  if (!s)
+    return;
   CU_ASSERT_EQUAL(rhod_scene_warnings(s, buf, sizeof buf), 3);
   CU_ASSERT_PTR_NOT_NULL(strstr(buf, "time.output_every"));
   CU_ASSERT_PTR_NOT_NULL(strstr(buf, "output.picture.range"));
@@ -504,11 +520,13 @@ static void test_default_name(void) {
   CU_ASSERT_PTR_NOT_NULL_FATAL(in);
   CU_ASSERT_PTR_NOT_NULL_FATAL(out);
   int ch;
-  while ((ch = fgetc(in)) != EOF) fputc(ch, out);
+  while ((ch = fgetc(in)) != EOF)
+    fputc(ch, out);
   fclose(in);
   fclose(out);
   rhod_scene *s = load_ok("test_scene_case_dir/scene.yaml", NULL, 0);
-  if (s) CU_ASSERT_STRING_EQUAL(s->name, "test_scene_case_dir");
+  if (s)
+    CU_ASSERT_STRING_EQUAL(s->name, "test_scene_case_dir");
   rhod_scene_free(s);
   remove("test_scene_case_dir/scene.yaml");
   rmdir(dir);

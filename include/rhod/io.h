@@ -27,11 +27,16 @@ typedef struct {
 /* OUT/snapshot_NNNN.h5: /Header attrs Time, Dimension (2), NumPart; /PartType0 datasets
  * Coordinates, Velocities (N x 3, z = 0), Densities, Pressures, Masses, ParticleSizes,
  * ParticleIDs, FreeSurface (if fs); /Parameters string attributes (dotted keys). Plain
- * contiguous datasets, no filters. Stored as double whatever the build precision. */
+ * contiguous datasets, no filters. Stored as double whatever the build precision.
+ * /Header also carries the strings Code ("rhod") and Precision (RHOD_REAL_NAME).
+ * The file is built in memory, then written through rhod_write_bytes_atomic.
+ * Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"), RHOD_ERR_MEMORY. */
 int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
                         const rhod_param_list *params, char *err, size_t errlen);
 
-/* Reads a snapshot written by rhod_write_snapshot (arrays malloc'd, double). */
+/* Reads a snapshot written by rhod_write_snapshot (arrays malloc'd, double). Errors:
+ * RHOD_ERR_READ (missing or unreadable file, missing dataset or attribute, wrong shape),
+ * RHOD_ERR_MEMORY; out is then empty. rhod_snapshot_data_free accepts an emptied one. */
 typedef struct {
   double time;
   size_t n;
@@ -46,13 +51,16 @@ void rhod_snapshot_data_free(rhod_snapshot_data *d);
 
 /* OUT/snapshots.xdmf: a temporal collection of every snapshot written so far, as a
  * Polyvertex grid that ParaView opens as a time series. Rewritten (atomically) after
- * each snapshot. */
+ * each snapshot. XDMF 2 like SWIFT's .xmf: ParaView's "XDMF Reader" makes one vertex
+ * cell per particle; its Xdmf3 readers give the points (Point Gaussian view) and fields. */
 int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
                     char *err, size_t errlen);
 
 /* A PNG picture of one field: each particle a disc of its own size, coloured by a
  * perceptual colour map; the frame is the box [lo, hi]; a colour bar with its range
- * and the time are drawn. range NULL: auto (min/max of the field). */
+ * and the time are drawn. range NULL: auto (min/max of the field). The picture is width
+ * pixels wide; below the frame is a strip with the bar and labels. Errors: RHOD_ERR_SCENE
+ * (empty frame, width or height outside 1..16384), RHOD_ERR_IO (cannot write). */
 int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
                        unsigned width, const double lo[2], const double hi[2],
                        const double *range, char *err, size_t errlen);

@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# The rhod command line: output layout, exit codes per class of failure, output
+# folder untouched by a run that fails its checks, an unstable run stopped with its
+# cause named and no NaN written.
+set -uo pipefail
+RHOD=$1; SRC=$2
+T=$(mktemp -d)
+trap 'chmod -R u+w "$T"; rm -rf "$T"' EXIT
+fail=0; pass=0
+expect() { # expect CODE DESCRIPTION -- command...
+  local code=$1 what=$2; shift 3
+  "$@" >"$T/stdout" 2>"$T/stderr"; local got=$?
+  if [ "$got" -ne "$code" ]; then
+    echo "FAIL: $what: exit $got, expected $code"; cat "$T/stderr"; fail=$((fail + 1))
+  else pass=$((pass + 1)); fi
+}
+check() { # check DESCRIPTION -- command...
+  local what=$1; shift 2
+  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $what"; fail=$((fail + 1)); fi
+}
+SCENE=$SRC/cases/hydrostatic/scene.yaml
+SHORT=(--set particles.dx=0.05 --set time.end=0.1 --set time.output_every=0.05)
+
+# a good run: the whole output layout
+expect 0 "short run" -- "$RHOD" run "$SCENE" -o "$T/ok" "${SHORT[@]}"
+for f in snapshot_0000.h5 snapshot_0002.h5 snapshot_0000.png snapshots.xdmf probes.csv \
+         summary.json run.log; do
+  check "output file $f" -- test -s "$T/ok/$f"
+done
+check "run log says where the kernels ran" -- grep -q "kernels run on" "$T/ok/run.log"
+check "summary status ok" -- grep -q '"status": "ok"' "$T/ok/summary.json"
+check "probes header starts with t" -- bash -c "head -1 '$T/ok/probes.csv' | grep -q '^t,'"
+
+# usage errors
+expect 2 "no arguments" -- "$RHOD"
+expect 2 "unknown command" -- "$RHOD" fly "$SCENE"
+expect 2 "run without scene" -- "$RHOD" run
+expect 2 "unknown option" -- "$RHOD" run "$SCENE" --frobnicate
+expect 2 "--set without =" -- "$RHOD" run "$SCENE" --set time.end
+
+# scene errors leave an existing output folder untouched
+mkdir -p "$T/keep"; echo precious >"$T/keep/snapshot_0000.h5"
+expect 3 "missing scene file" -- "$RHOD" run "$T/nope.yaml" -o "$T/keep"
+check "message names the file" -- grep -q "nope.yaml" "$T/stderr"
+expect 4 "bad override value" -- "$RHOD" run "$SCENE" -o "$T/keep" --set time.end=abc
+check "message names the key" -- grep -q "time.end" "$T/stderr"
+expect 4 "unknown override key" -- "$RHOD" run "$SCENE" -o "$T/keep" --set time.ending=1
+expect 4 "negative dx" -- "$RHOD" run "$SCENE" -o "$T/keep" --set particles.dx=-1
+check "output folder untouched" -- bash -c "[ \"\$(cat '$T/keep/snapshot_0000.h5')\" = precious ] && [ \$(ls '$T/keep' | wc -l) -eq 1 ]"
+
+# output folder problems
+echo file >"$T/afile"
+expect 5 "output path is a file" -- "$RHOD" run "$SCENE" -o "$T/afile" "${SHORT[@]}"
+expect 5 "output under a file" -- "$RHOD" run "$SCENE" -o "$T/afile/sub" "${SHORT[@]}"
+if [ -e /dev/full ]; then
+  # a full disk while writing: ENOSPC on every write to /dev/full
+  mkdir -p "$T/full"; ln -s /dev/full "$T/full/probes.csv"
+  expect 7 "full disk while writing probes" -- "$RHOD" run "$SCENE" -o "$T/full" "${SHORT[@]}"
+fi
+
+# an unstable run: c0 far too small for the column, a huge CFL
+expect 6 "unstable run stops" -- "$RHOD" run "$SCENE" -o "$T/bad" --set particles.dx=0.05 \
+  --set physics.c0=0.5 --set time.cfl=1.0 --set time.end=5 --set time.output_every=0.01
+check "cause names a particle" -- grep -q "particle id" "$T/stderr"
+check "summary says unstable" -- grep -q '"status": "unstable"' "$T/bad/summary.json"
+check "no NaN in any snapshot" -- /usr/bin/python3 - "$T/bad" <<'PY'
+import glob, sys
+import h5py, numpy as np
+snaps = sorted(glob.glob(sys.argv[1] + "/snapshot_*.h5"))
+assert snaps, "no snapshot kept"
+for s in snaps:
+    with h5py.File(s) as f:
+        for k in f["PartType0"]:
+            a = f["PartType0"][k][()]
+            if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+                sys.exit(f"{s}: {k} not finite")
+PY
+
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
