@@ -367,7 +367,7 @@ static int vfail_at(lctx *c, const ry_node *n, const char *path, const char *fmt
   char reason[768];
   vsnprintf(reason, sizeof reason, fmt, ap);
   if (n && n->origin >= 0 && n->origin < c->n_ov)
-    put_msg(c, "--set %s: %s: %s", c->ov[n->origin], shown(path), reason);
+    put_msg(c, "--set %s: %s: %s", c->ov[n->origin] ? c->ov[n->origin] : "", shown(path), reason);
   else
     put_msg(c, "%s:%u:%u: %s: %s", c->file, n ? n->line : 1u, n ? n->col : 1u, shown(path), reason);
   return RHOD_ERR_SCENE;
@@ -398,7 +398,7 @@ static int fail_ov(lctx *c, int k, const char *path, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(reason, sizeof reason, fmt, ap);
   va_end(ap);
-  put_msg(c, "--set %s: %s: %s", c->ov[k], shown(path), reason);
+  put_msg(c, "--set %s: %s: %s", c->ov[k] ? c->ov[k] : "", shown(path), reason);
   return RHOD_ERR_SCENE;
 }
 

@@ -571,6 +571,13 @@ static void test_null_safety(void) {
   rhod_param_list_free(NULL);
   CU_ASSERT_EQUAL(rhod_scene_warnings(NULL, NULL, 0), 0);
   CU_ASSERT_EQUAL(rhod_scene_load(GOOD("minimal.yaml"), NULL, 0, NULL, NULL, 0), RHOD_ERR_USAGE);
+  const char *null_set[] = {NULL};
+  char err[256];
+  rhod_scene *s;
+  CU_ASSERT_EQUAL(rhod_scene_load(GOOD("minimal.yaml"), null_set, 1, &s, err, sizeof err),
+                  RHOD_ERR_SCENE);
+  CU_ASSERT_PTR_NOT_NULL(strstr(err, "expected dotted.key=value"));
+  CU_ASSERT_EQUAL(rhod_scene_load(NULL, NULL, 0, &s, err, sizeof err), RHOD_ERR_READ);
 }
 
 int main(void) {
