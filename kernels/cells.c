@@ -17,7 +17,7 @@ static int32_t *blocks_buffer(size_t nb) {
 #ifdef RHOD_OFFLOAD
       int32_t *b = scan_blocks;
       size_t c = scan_blocks_cap;
-#pragma omp target exit data map(delete : b[0 : c])
+#pragma omp target exit data map(delete : b [0:c])
       (void)b; /* GCC 12 flags map-only variables as unused */
 #endif
       free(scan_blocks);
@@ -31,7 +31,7 @@ static int32_t *blocks_buffer(size_t nb) {
 #ifdef RHOD_OFFLOAD
     int32_t *b = scan_blocks;
     size_t c = scan_blocks_cap;
-#pragma omp target enter data map(alloc : b[0 : c])
+#pragma omp target enter data map(alloc : b [0:c])
     (void)b; /* GCC 12 flags map-only variables as unused */
 #endif
   }
@@ -39,17 +39,20 @@ static int32_t *blocks_buffer(size_t nb) {
 }
 
 long rhod_scan_exclusive(int32_t *a, size_t n) {
-  if (n == 0) return 0;
+  if (n == 0)
+    return 0;
   const long nb = (long)((n + SCAN_BLOCK - 1) / SCAN_BLOCK);
   int32_t *bs = blocks_buffer((size_t)nb);
-  if (!bs) return -1;
+  if (!bs)
+    return -1;
   const long nn = (long)n;
   /* 1. each block's sum */
   RHOD_KERNEL_LOOP
   for (long b = 0; b < nb; b++) {
     long s = 0;
     const long e = (b + 1) * SCAN_BLOCK < nn ? (b + 1) * SCAN_BLOCK : nn;
-    for (long k = b * SCAN_BLOCK; k < e; k++) s += a[k];
+    for (long k = b * SCAN_BLOCK; k < e; k++)
+      s += a[k];
     bs[b] = (int32_t)s;
   }
   /* 2. scan of the block sums (few: one thread) */
@@ -85,17 +88,18 @@ static void map_alloc(int32_t **p, size_t n) {
 #ifdef RHOD_OFFLOAD
   int32_t *q = *p;
   if (q) {
-#pragma omp target enter data map(to : q[0 : n])
-  (void)q; /* GCC 12 flags map-only variables as unused */
+#pragma omp target enter data map(to : q [0:n])
+    (void)q; /* GCC 12 flags map-only variables as unused */
   }
 #endif
 }
 
 static void map_free(int32_t **p, size_t n) {
-  if (!*p) return;
+  if (!*p)
+    return;
 #ifdef RHOD_OFFLOAD
   int32_t *q = *p;
-#pragma omp target exit data map(delete : q[0 : n])
+#pragma omp target exit data map(delete : q [0:n])
   (void)q; /* GCC 12 flags map-only variables as unused */
 #else
   (void)n;
@@ -107,27 +111,33 @@ static void map_free(int32_t **p, size_t n) {
 int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double cell,
                     size_t cap) {
   memset(c, 0, sizeof *c);
-  if (!(cell > 0)) return RHOD_ERR_SCENE;
+  if (!(cell > 0))
+    return RHOD_ERR_SCENE;
   const double w = hi[0] - lo[0], h = hi[1] - lo[1];
   c->g.nx = (int)floor(w / cell);
   c->g.ny = (int)floor(h / cell);
-  if (c->g.nx < 1) c->g.nx = 1;
-  if (c->g.ny < 1) c->g.ny = 1;
+  if (c->g.nx < 1)
+    c->g.nx = 1;
+  if (c->g.ny < 1)
+    c->g.ny = 1;
   /* cells a little larger than asked so that nx cells tile the box exactly */
   const double cw = fmax(w / c->g.nx, h / c->g.ny);
-  if ((double)c->g.nx * c->g.ny > 2e9) return RHOD_ERR_MEMORY;
+  if ((double)c->g.nx * c->g.ny > 2e9)
+    return RHOD_ERR_MEMORY;
   c->g.ox = (real)lo[0];
   c->g.oy = (real)lo[1];
   c->g.inv = (real)(1.0 / cw);
   c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   map_alloc(&c->start, c->ncells + 1);
   map_alloc(&c->count, c->ncells + 1);
-  if (!c->start || !c->count) return RHOD_ERR_MEMORY;
+  if (!c->start || !c->count)
+    return RHOD_ERR_MEMORY;
   return rhod_cells_reserve(c, cap);
 }
 
 int rhod_cells_reserve(rhod_cells *c, size_t cap) {
-  if (cap <= c->cap && c->idx) return RHOD_OK;
+  if (cap <= c->cap && c->idx)
+    return RHOD_OK;
   map_free(&c->idx, c->cap);
   map_free(&c->key, c->cap);
   c->cap = cap;
@@ -149,7 +159,8 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
   const long n = (long)count, nc = (long)c->ncells;
 
   RHOD_KERNEL_LOOP
-  for (long k = 0; k <= nc; k++) cnt[k] = 0;
+  for (long k = 0; k <= nc; k++)
+    cnt[k] = 0;
 
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
@@ -164,7 +175,8 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
   rhod_scan_exclusive(cnt, (size_t)nc + 1);
 
   RHOD_KERNEL_LOOP
-  for (long k = 0; k <= nc; k++) start[k] = cnt[k];
+  for (long k = 0; k <= nc; k++)
+    start[k] = cnt[k];
 
   /* scatter; the slot order inside a cell depends on thread timing ... */
   RHOD_KERNEL_LOOP

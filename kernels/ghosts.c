@@ -19,8 +19,10 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     const real rx = x - S[0], ry = y - S[1];
     const real d = S[2] * rx + S[3] * ry;
     const real t = S[4] * rx + S[5] * ry;
-    if (!(d > 0 && d < R && t >= 0 && t <= S[6])) continue;
-    if (s < 32) near |= 1u << s;
+    if (!(d > 0 && d < R && t >= 0 && t <= S[6]))
+      continue;
+    if (s < 32)
+      near |= 1u << s;
     gx[n] = x - 2 * d * S[2];
     gy[n] = y - 2 * d * S[3];
     real *Jn = J + 4 * n, *Tn = T + 4 * n;
@@ -31,20 +33,23 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     if (S[7] != 0) {
       Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
     } else {
-      for (int k = 0; k < 4; k++) Tn[k] = Jn[k];
+      for (int k = 0; k < 4; k++)
+        Tn[k] = Jn[k];
     }
     n++;
   }
   for (int c = 0; c < ncorner && n < RHOD_MAX_GHOSTS_PER_PARTICLE; c++) {
     const int a = corner[2 * c], b = corner[2 * c + 1];
-    if (a >= 32 || b >= 32 || !((near >> a) & 1u) || !((near >> b) & 1u)) continue;
+    if (a >= 32 || b >= 32 || !((near >> a) & 1u) || !((near >> b) & 1u))
+      continue;
     const real *A = seg + RHOD_SEG_STRIDE * a, *B = seg + RHOD_SEG_STRIDE * b;
     /* reflect in a, then in b */
     const real da = A[2] * (x - A[0]) + A[3] * (y - A[1]);
     const real x1 = x - 2 * da * A[2], y1 = y - 2 * da * A[3];
     const real db = B[2] * (x1 - B[0]) + B[3] * (y1 - B[1]);
     const real x2 = x1 - 2 * db * B[2], y2 = y1 - 2 * db * B[3];
-    if ((x2 - x) * (x2 - x) + (y2 - y) * (y2 - y) >= R * R) continue;
+    if ((x2 - x) * (x2 - x) + (y2 - y) * (y2 - y) >= R * R)
+      continue;
     gx[n] = x2;
     gy[n] = y2;
     const real Ja[4] = {1 - 2 * A[2] * A[2], -2 * A[2] * A[3], -2 * A[2] * A[3],
@@ -59,7 +64,8 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     if (A[7] != 0 || B[7] != 0) {
       Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
     } else {
-      for (int k = 0; k < 4; k++) Tn[k] = Jn[k];
+      for (int k = 0; k < 4; k++)
+        Tn[k] = Jn[k];
     }
     n++;
   }
@@ -67,11 +73,14 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     const real *C = circ + RHOD_CIRC_STRIDE * c;
     const real rx = x - C[0], ry = y - C[1];
     const real dist = sqrt(rx * rx + ry * ry);
-    if (!(dist > 0)) continue;
+    if (!(dist > 0))
+      continue;
     const real d = C[3] > 0 ? C[2] - dist : dist - C[2]; /* distance into the fluid */
-    if (!(d > 0 && d < R)) continue;
+    if (!(d > 0 && d < R))
+      continue;
     const real rg = C[3] > 0 ? C[2] + d : C[2] - d; /* mirror radius */
-    if (!(rg > 0)) continue;
+    if (!(rg > 0))
+      continue;
     const real ex = rx / dist, ey = ry / dist;
     gx[n] = C[0] + rg * ex;
     gy[n] = C[1] + rg * ey;
@@ -84,7 +93,8 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     if (C[4] != 0) {
       Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
     } else {
-      for (int k = 0; k < 4; k++) Tn[k] = Jn[k];
+      for (int k = 0; k < 4; k++)
+        Tn[k] = Jn[k];
     }
     n++;
   }
@@ -92,23 +102,25 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
 }
 
 static int ensure_count(rhod_boundary *b, size_t need) {
-  if (need <= b->count_cap && b->count) return RHOD_OK;
+  if (need <= b->count_cap && b->count)
+    return RHOD_OK;
   if (b->count) {
 #ifdef RHOD_OFFLOAD
     int32_t *c = b->count;
     size_t cc = b->count_cap;
-#pragma omp target exit data map(delete : c[0 : cc])
+#pragma omp target exit data map(delete : c [0:cc])
     (void)c; /* GCC 12 flags map-only variables as unused */
 #endif
     free(b->count);
   }
   b->count_cap = need + need / 4 + 64;
   b->count = calloc(b->count_cap, sizeof(int32_t));
-  if (!b->count) return RHOD_ERR_MEMORY;
+  if (!b->count)
+    return RHOD_ERR_MEMORY;
 #ifdef RHOD_OFFLOAD
   int32_t *c = b->count;
   size_t cc = b->count_cap;
-#pragma omp target enter data map(alloc : c[0 : cc])
+#pragma omp target enter data map(alloc : c [0:cc])
   (void)c; /* GCC 12 flags map-only variables as unused */
 #endif
   return RHOD_OK;
@@ -117,9 +129,11 @@ static int ensure_count(rhod_boundary *b, size_t need) {
 /* Phase 1: wall mirrors of the fluid. Returns the number of ghosts written or < 0. */
 static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
   const int nseg = b->nseg, ncorner = b->ncorner, ncirc = b->ncirc;
-  if (nseg + ncirc == 0) return 0;
+  if (nseg + ncirc == 0)
+    return 0;
   const long n = (long)p->n;
-  if (ensure_count(b, p->n + 1) != RHOD_OK) return -1;
+  if (ensure_count(b, p->n + 1) != RHOD_OK)
+    return -1;
   for (;;) {
     const real *seg = b->seg, *circ = b->circ;
     const int32_t *corner = b->corner;
@@ -133,26 +147,28 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       }
       real gx[RHOD_MAX_GHOSTS_PER_PARTICLE], gy[RHOD_MAX_GHOSTS_PER_PARTICLE];
       real J[4 * RHOD_MAX_GHOSTS_PER_PARTICLE], T[4 * RHOD_MAX_GHOSTS_PER_PARTICLE];
-      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i],
-                            ratio * dx[i], gx, gy, J, T);
+      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i], ratio * dx[i], gx,
+                            gy, J, T);
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)n + 1);
-    if (total < 0) return -1;
+    if (total < 0)
+      return -1;
     if (p->n + (size_t)total + 1 > p->cap) {
-      if (rhod_particles_reserve(p, p->n + (size_t)total + 1) != RHOD_OK) return -1;
+      if (rhod_particles_reserve(p, p->n + (size_t)total + 1) != RHOD_OK)
+        return -1;
       continue; /* the arrays moved: count again */
     }
-    real *gxo = p->x, *gyo = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT,
-         *ge = p->ge;
+    real *gxo = p->x, *gyo = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
     int32_t *gsrc = p->gsrc;
     RHOD_KERNEL_LOOP
     for (long i = 0; i < n; i++) {
       const int c = cnt[i + 1] - cnt[i];
-      if (c == 0) continue;
+      if (c == 0)
+        continue;
       real gx[RHOD_MAX_GHOSTS_PER_PARTICLE], gy[RHOD_MAX_GHOSTS_PER_PARTICLE];
       real J[4 * RHOD_MAX_GHOSTS_PER_PARTICLE], T[4 * RHOD_MAX_GHOSTS_PER_PARTICLE];
-      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, gxo[i], gyo[i], ratio * gdx[i], gx,
-                   gy, J, T);
+      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, gxo[i], gyo[i], ratio * gdx[i], gx, gy,
+                   J, T);
       for (int k = 0; k < c; k++) {
         const long g = n + cnt[i] + k;
         gxo[g] = gx[k];
@@ -174,12 +190,13 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
 
 /* Phase 2: periodic images of fluid and wall ghosts [0, n + nw). */
 static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real margin) {
-  if (!b->periodic[0] && !b->periodic[1]) return 0;
+  if (!b->periodic[0] && !b->periodic[1])
+    return 0;
   const long n = (long)p->n, nsrc = n + nw;
-  if (ensure_count(b, (size_t)nsrc + 1) != RHOD_OK) return -1;
+  if (ensure_count(b, (size_t)nsrc + 1) != RHOD_OK)
+    return -1;
   const int px = b->periodic[0], py = b->periodic[1];
-  const real lox = (real)b->lo[0], hix = (real)b->hi[0], loy = (real)b->lo[1],
-             hiy = (real)b->hi[1];
+  const real lox = (real)b->lo[0], hix = (real)b->hi[0], loy = (real)b->lo[1], hiy = (real)b->hi[1];
   const real Lx = hix - lox, Ly = hiy - loy;
   for (;;) {
     int32_t *cnt = b->count;
@@ -193,19 +210,24 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
       int c = 0;
       for (int sy = -py; sy <= py; sy++)
         for (int sx = -px; sx <= px; sx++) {
-          if (sx == 0 && sy == 0) continue;
+          if (sx == 0 && sy == 0)
+            continue;
           const real X = x[k] + sx * Lx, Y = y[k] + sy * Ly;
-          if (sx != 0 && (X < lox - margin || X > hix + margin)) continue;
-          if (sy != 0 && (Y < loy - margin || Y > hiy + margin)) continue;
+          if (sx != 0 && (X < lox - margin || X > hix + margin))
+            continue;
+          if (sy != 0 && (Y < loy - margin || Y > hiy + margin))
+            continue;
           c++;
         }
       cnt[k] = c;
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)nsrc + 1);
-    if (total < 0) return -1;
+    if (total < 0)
+      return -1;
     if ((size_t)(nsrc + total) + 1 > p->cap) {
       /* growing keeps only the fluid: the wall ghosts must be built again */
-      if (rhod_particles_reserve(p, (size_t)(nsrc + total) + 1) != RHOD_OK) return -1;
+      if (rhod_particles_reserve(p, (size_t)(nsrc + total) + 1) != RHOD_OK)
+        return -1;
       return -2;
     }
     real *X = p->x, *Y = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
@@ -213,13 +235,17 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
     RHOD_KERNEL_LOOP
     for (long k = 0; k < nsrc; k++) {
       long g = nsrc + cnt[k];
-      if (cnt[k + 1] == cnt[k]) continue;
+      if (cnt[k + 1] == cnt[k])
+        continue;
       for (int sy = -py; sy <= py; sy++)
         for (int sx = -px; sx <= px; sx++) {
-          if (sx == 0 && sy == 0) continue;
+          if (sx == 0 && sy == 0)
+            continue;
           const real xs = X[k] + sx * Lx, ys = Y[k] + sy * Ly;
-          if (sx != 0 && (xs < lox - margin || xs > hix + margin)) continue;
-          if (sy != 0 && (ys < loy - margin || ys > hiy + margin)) continue;
+          if (sx != 0 && (xs < lox - margin || xs > hix + margin))
+            continue;
+          if (sy != 0 && (ys < loy - margin || ys > hiy + margin))
+            continue;
           X[g] = xs;
           Y[g] = ys;
           m[g] = m[k];
@@ -248,11 +274,14 @@ int rhod_ghosts_build(rhod_boundary *b, rhod_particles *p, real radius_ratio, re
   for (;;) {
     p->ng = 0;
     const long nw = build_wall_ghosts(b, p, radius_ratio);
-    if (nw < 0) return RHOD_ERR_MEMORY;
+    if (nw < 0)
+      return RHOD_ERR_MEMORY;
     p->ng = (size_t)nw;
     const long np = build_periodic(b, p, nw, margin);
-    if (np == -2) continue;
-    if (np < 0) return RHOD_ERR_MEMORY;
+    if (np == -2)
+      continue;
+    if (np < 0)
+      return RHOD_ERR_MEMORY;
     p->ng += (size_t)np;
     return RHOD_OK;
   }
@@ -267,7 +296,8 @@ int rhod_ghosts_build(rhod_boundary *b, rhod_particles *p, real radius_ratio, re
  * left for the domain check to report. Returns how many were reflected. */
 long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
   const int nseg = b->nseg, ncirc = b->ncirc;
-  if (nseg + ncirc == 0) return 0;
+  if (nseg + ncirc == 0)
+    return 0;
   const long n = (long)p->n;
   const real *seg = b->seg, *circ = b->circ;
   real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy;
@@ -283,7 +313,8 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
       if (d <= 0 && d > -lim && t >= 0 && t <= S[6]) {
         x[i] -= 2 * d * S[2], y[i] -= 2 * d * S[3];
         const real un = ux[i] * S[2] + uy[i] * S[3];
-        if (un < 0) ux[i] -= 2 * un * S[2], uy[i] -= 2 * un * S[3];
+        if (un < 0)
+          ux[i] -= 2 * un * S[2], uy[i] -= 2 * un * S[3];
         count++;
       }
     }
@@ -295,7 +326,8 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
         const real ex = C[3] * (-rx / dist), ey = C[3] * (-ry / dist); /* into the fluid */
         x[i] -= 2 * d * ex, y[i] -= 2 * d * ey;
         const real un = ux[i] * ex + uy[i] * ey;
-        if (un < 0) ux[i] -= 2 * un * ex, uy[i] -= 2 * un * ey;
+        if (un < 0)
+          ux[i] -= 2 * un * ex, uy[i] -= 2 * un * ey;
         count++;
       }
     }

@@ -13,7 +13,8 @@
 /* W(r; R). */
 static inline real rhod_W(int kind, real r, real R) {
   const real q = r / R;
-  if (q >= 1) return 0;
+  if (q >= 1)
+    return 0;
   const real iR2 = 1 / (R * R);
   if (kind == RHOD_KERNEL_WENDLAND_C2) {
     /* Wendland C2 (paper 002 Sec. IV A, Ref. 92): 7/(pi R^2) (1-q)^4 (1+4q) */
@@ -45,7 +46,8 @@ static inline real rhod_W(int kind, real r, real R) {
 /* dW/dr (<= 0). */
 static inline real rhod_dW(int kind, real r, real R) {
   const real q = r / R;
-  if (q >= 1) return 0;
+  if (q >= 1)
+    return 0;
   const real iR3 = 1 / (R * R * R);
   if (kind == RHOD_KERNEL_WENDLAND_C2) {
     const real a = 1 - q;

@@ -2,8 +2,8 @@
  * Every pass is a gather: it writes only particle i's own entries. Conventions:
  * n_ij = (x_j - x_i)/r, grad_i W_ij = -W'(r; R_i) n_ij = F n_ij with F >= 0, and
  * W taken with the radius of the gathering particle i. */
-#include "rhod/sph.h"
 #include "kernel.h"
+#include "rhod/sph.h"
 #include "sph_pair.h"
 #include <float.h>
 #include <math.h>
@@ -34,8 +34,8 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   s->gamma_th = (real)sc->shepard_threshold;
   s->theta_th = (real)sc->theta_threshold;
   int st = RHOD_OK;
-#define F(var, k)                                                                         \
-  if (st == RHOD_OK)                                                                      \
+#define F(var, k)                                                                                  \
+  if (st == RHOD_OK)                                                                               \
   st = rhod_particles_add_field(p, #var, (void **)&s->var, (k) * sizeof(*s->var), 0)
   F(P, 1);
   F(V, 1);
@@ -96,8 +96,8 @@ static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const int32_t *CS = c->start, *CI = c->idx;
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *dx = p->dx;
   const real *P = s->P, *V = s->V;
-  real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D,
-       *gC = s->gC, *uch = s->uch, *lam = s->lam;
+  real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *gC = s->gC,
+       *uch = s->uch, *lam = s->lam;
   const int kern = s->kernel;
   const real ratio = s->ratio;
   RHOD_KERNEL_LOOP
@@ -106,8 +106,7 @@ static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     const real uxi = ux[i], uyi = uy[i], Pi = P[i], dxi = dx[i];
     real g = rhod_W(kern, 0, Ri) * V[i]; /* self term of Eq. 7 */
     real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
-    real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0,
-         um = 0;
+    real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0, um = 0;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
       if (r2 < R2 && j != i) {
@@ -117,15 +116,15 @@ static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
         const real F = -rhod_dW(kern, r, Ri) * Vj; /* |grad_i W_ij| V_j */
         const real Wv = rhod_W(kern, r, Ri) * Vj;
         const real gwx = F * nx, gwy = F * ny;
-        g += Wv;                                  /* Eq. 7 */
-        ggx += gwx, ggy += gwy;                   /* Eq. 27 */
-        B0 += rx * gwx, B1 += rx * gwy;           /* Eq. 8: B_ab = sum r_a g_b V */
+        g += Wv;                        /* Eq. 7 */
+        ggx += gwx, ggy += gwy;         /* Eq. 27 */
+        B0 += rx * gwx, B1 += rx * gwy; /* Eq. 8: B_ab = sum r_a g_b V */
         B2 += ry * gwx, B3 += ry * gwy;
         const real dP = P[j] - Pi, dux = ux[j] - uxi, duy = uy[j] - uyi;
-        GPx += dP * gwx, GPy += dP * gwy;         /* Eq. 14, raw */
+        GPx += dP * gwx, GPy += dP * gwy; /* Eq. 14, raw */
         Gu0 += dux * gwx, Gu1 += dux * gwy;
         Gu2 += duy * gwx, Gu3 += duy * gwy;
-        div += dux * gwx + duy * gwy;             /* Eq. 5 */
+        div += dux * gwx + duy * gwy; /* Eq. 5 */
         /* Eq. 29: [1 + 0.2 (W_ij / W(dx_ij))^4] grad_i W_ij V_j, W(dx_ij) with R_i */
         const real wr = rhod_W(kern, r, Ri) / rhod_W(kern, (real)0.5 * (dxi + dx[j]), Ri);
         const real f = 1 + (real)0.2 * wr * wr * wr * wr;
@@ -245,7 +244,8 @@ static void pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *
       if (j != i && r2 < R2) {
         const real qx = x[j] - Tx, qy = y[j] - Ty;
         if (r2 >= s2h2) {
-          if (qx * qx + qy * qy < h2) occupied = 1;
+          if (qx * qx + qy * qy < h2)
+            occupied = 1;
         } else if (fabs(nx * qx + ny * qy) + fabs(tx * qx + ty * qy) < h) {
           occupied = 1;
         }
@@ -307,7 +307,8 @@ static void pass_region(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       if (r2 < R2 && fs[j]) {
         const real w = rhod_W(kern, sqrt(r2), Ri);
         sx += w * nrm[2 * j], sy += w * nrm[2 * j + 1];
-        if (j != i && r2 < dmin2) dmin2 = r2;
+        if (j != i && r2 < dmin2)
+          dmin2 = r2;
         any = 1;
       }
     }
@@ -331,11 +332,11 @@ static void pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
   real *du = s->du;
   if (!s->shifting) {
     RHOD_KERNEL_LOOP
-    for (long i = 0; i < nt_; i++) du[2 * i] = 0, du[2 * i + 1] = 0;
+    for (long i = 0; i < nt_; i++)
+      du[2 * i] = 0, du[2 * i + 1] = 0;
     return;
   }
-  const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *uch = s->uch, *ggam = s->ggam,
-             *dx = p->dx;
+  const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *uch = s->uch, *ggam = s->ggam, *dx = p->dx;
   const real ratio = s->ratio, a = s->sa, b = s->sb, eps = s->seps;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
@@ -375,8 +376,8 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *dx = p->dx;
-  const real *P = s->P, *V = s->V, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D,
-             *du = s->du, *gam = s->gam;
+  const real *P = s->P, *V = s->V, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *du = s->du,
+             *gam = s->gam;
   const uint8_t *reg = s->reg;
   real *drho = s->drho, *acc = s->acc, *vel = s->vel;
   const int kern = s->kernel, riemann = s->riemann, recon = s->recon, damper = s->damper,
@@ -392,11 +393,11 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     const real dui = du[2 * i], dvi = du[2 * i + 1];
     const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];
     const real *Gi = gu + 4 * i;
-    real pmx = 0, pmy = 0, ppx = 0, ppy = 0; /* sums of Eq. 6, both forms */
-    real thx = 0, thy = 0;                   /* sum theta_ij grad W V, Eq. 24 */
-    real cont = 0;                           /* continuity, Eq. 22 */
-    real adx = 0, ady = 0;                   /* Eq. 9 */
-    real vsx = 0, vsy = 0;                   /* Eq. 10 */
+    real pmx = 0, pmy = 0, ppx = 0, ppy = 0;    /* sums of Eq. 6, both forms */
+    real thx = 0, thy = 0;                      /* sum theta_ij grad W V, Eq. 24 */
+    real cont = 0;                              /* continuity, Eq. 22 */
+    real adx = 0, ady = 0;                      /* Eq. 9 */
+    real vsx = 0, vsy = 0;                      /* Eq. 10 */
     real ddu = 0, drdu = 0, ruux = 0, ruuy = 0; /* Eq. 4 */
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
@@ -477,7 +478,8 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       const real k = alpha_ad * rho0 * c0 * (real)0.5 * Ri;
       fx += k * adx, fy += k * ady;
     }
-    if (visc_k != 0) fx += alpha_mu * visc_k * vsx, fy += alpha_mu * visc_k * vsy;
+    if (visc_k != 0)
+      fx += alpha_mu * visc_k * vsx, fy += alpha_mu * visc_k * vsy;
     if (shifting) { /* Eq. 4 */
       dr += -rhoi * ddu + drdu;
       fx += ruux, fy += ruuy;
@@ -503,7 +505,8 @@ real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {
   const real *dx = p->dx;
   real dmin = (real)FLT_MAX;
   RHOD_KERNEL_LOOP_REDUCE(min, dmin)
-  for (long i = 0; i < n; i++) dmin = dx[i] < dmin ? dx[i] : dmin;
+  for (long i = 0; i < n; i++)
+    dmin = dx[i] < dmin ? dx[i] : dmin;
   const real R = s->ratio * dmin;
   /* Eq. 11 */
   real dt = s->cfl * R / s->c0;

@@ -12,8 +12,8 @@ static inline real rhod_limit(real s1, real s2) {
 
 /* Primitive-variable Riemann solver (PVRS), Eqs. 17 and 19, with c_L = c_R = c0:
  * normal velocity u_E and pressure P_E at the interface. */
-static inline void rhod_pvrs(real rhoL, real rhoR, real uL, real uR, real PL, real PR,
-                             real c0, real *uE, real *PE) {
+static inline void rhod_pvrs(real rhoL, real rhoR, real uL, real uR, real PL, real PR, real c0,
+                             real *uE, real *PE) {
   const real irs = 1 / (rhoL + rhoR);
   *uE = (rhoR * uR + rhoL * uL) * irs + (PL - PR) * irs / c0;
   *PE = (rhoR * PL + rhoL * PR) * irs + rhoR * rhoL * c0 * (uL - uR) * irs;
@@ -22,8 +22,8 @@ static inline void rhod_pvrs(real rhoL, real rhoR, real uL, real uR, real PL, re
 /* Left and right states of Eq. 16 along n_ij for a field phi with values phi_i, phi_j,
  * directional derivatives gi = grad phi_i . n_ij and gj = grad phi_j . n_ij, the pair
  * distance r and the weights w_i, w_j of Eq. 12. */
-static inline void rhod_states(real phii, real phij, real gi, real gj, real r, real wi,
-                               real wj, int recon, real *L, real *R) {
+static inline void rhod_states(real phii, real phij, real gi, real gj, real r, real wi, real wj,
+                               int recon, real *L, real *R) {
   if (!recon) {
     *L = phii;
     *R = phij;

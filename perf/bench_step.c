@@ -79,11 +79,12 @@ int main(int argc, char **argv) {
   }
   const double wall = now() - t0;
   size_t bytes = 0;
-  for (int f = 0; f < p->nfields; f++) bytes += p->fields[f].elem;
+  for (int f = 0; f < p->nfields; f++)
+    bytes += p->fields[f].elem;
   char where[256];
   rhod_where(where, sizeof where);
-  printf("N = %zu (ghosts %zu), %d steps, %s precision, %s\n", p->n, p->ng, steps,
-         RHOD_REAL_NAME, where);
+  printf("N = %zu (ghosts %zu), %d steps, %s precision, %s\n", p->n, p->ng, steps, RHOD_REAL_NAME,
+         where);
   printf("us per particle-step: %.3f   particle-steps per second: %.4g   bytes per particle: "
          "%zu\n",
          1e6 * wall / ((double)p->n * steps), (double)p->n * steps / wall, bytes);

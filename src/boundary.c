@@ -16,12 +16,14 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
   const double side = (area > 0 ? 1.0 : -1.0) * (fluid_inside ? 1.0 : -1.0);
   const int first = *nseg;
   real *s = realloc(*seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)(*nseg + (int)np));
-  if (!s) return RHOD_ERR_MEMORY;
+  if (!s)
+    return RHOD_ERR_MEMORY;
   *seg = s;
   for (unsigned k = 0; k < np; k++) {
     const double *a = pt[k], *b = pt[(k + 1) % np];
     const double tx = b[0] - a[0], ty = b[1] - a[1], len = hypot(tx, ty);
-    if (!(len > 0)) continue;
+    if (!(len > 0))
+      continue;
     real *S = s + RHOD_SEG_STRIDE * (*nseg);
     S[0] = (real)a[0];
     S[1] = (real)a[1];
@@ -42,7 +44,8 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
     const real *A = s + RHOD_SEG_STRIDE * a, *B = s + RHOD_SEG_STRIDE * b;
     if (A[2] * B[4] + A[3] * B[5] > 1e-9) {
       int32_t *c = realloc(*corner, sizeof(int32_t) * 2 * (size_t)(*ncorner + 1));
-      if (!c) return RHOD_ERR_MEMORY;
+      if (!c)
+        return RHOD_ERR_MEMORY;
       *corner = c;
       c[2 * *ncorner] = a;
       c[2 * *ncorner + 1] = b;
@@ -56,8 +59,8 @@ static void to_device(void *ptr, size_t bytes) {
 #ifdef RHOD_OFFLOAD
   char *c = ptr;
   if (c && bytes) {
-#pragma omp target enter data map(to : c[0 : bytes])
-  (void)c; /* GCC 12 flags map-only variables as unused */
+#pragma omp target enter data map(to : c [0:bytes])
+    (void)c; /* GCC 12 flags map-only variables as unused */
   }
 #else
   (void)ptr;
@@ -69,8 +72,8 @@ static void off_device(void *ptr, size_t bytes) {
 #ifdef RHOD_OFFLOAD
   char *c = ptr;
   if (c && bytes) {
-#pragma omp target exit data map(delete : c[0 : bytes])
-  (void)c; /* GCC 12 flags map-only variables as unused */
+#pragma omp target exit data map(delete : c [0:bytes])
+    (void)c; /* GCC 12 flags map-only variables as unused */
   }
 #else
   (void)ptr;
@@ -93,15 +96,16 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
     if (W->shape.kind == RHOD_SHAPE_RECT) {
       const double *m = W->shape.min, *M = W->shape.max;
       const double pts[4][2] = {{m[0], m[1]}, {M[0], m[1]}, {M[0], M[1]}, {m[0], M[1]}};
-      st = push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner, pts, 4, W->fluid_inside,
-                        noslip);
+      st =
+          push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner, pts, 4, W->fluid_inside, noslip);
     } else if (W->shape.kind == RHOD_SHAPE_POLYGON) {
       st = push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner,
-                        (const double(*)[2])W->shape.points, W->shape.n_points,
-                        W->fluid_inside, noslip);
+                        (const double(*)[2])W->shape.points, W->shape.n_points, W->fluid_inside,
+                        noslip);
     } else {
       real *c = realloc(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)(b->ncirc + 1));
-      if (!c) return RHOD_ERR_MEMORY;
+      if (!c)
+        return RHOD_ERR_MEMORY;
       b->circ = c;
       real *C = c + RHOD_CIRC_STRIDE * b->ncirc;
       C[0] = (real)W->shape.center[0];
@@ -111,7 +115,8 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
       C[4] = (real)noslip;
       b->ncirc++;
     }
-    if (st != RHOD_OK) return st;
+    if (st != RHOD_OK)
+      return st;
   }
   to_device(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
   to_device(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
@@ -141,12 +146,14 @@ double rhod_wall_distance(const rhod_boundary *b, double x, double y) {
     const double px = S[0] + t * S[4], py = S[1] + t * S[5];
     const double dist = hypot(x - px, y - py);
     const double sgn = (rx * S[2] + ry * S[3]) >= 0 ? 1.0 : -1.0;
-    if (dist < fabs(best)) best = sgn * dist;
+    if (dist < fabs(best))
+      best = sgn * dist;
   }
   for (int c = 0; c < b->ncirc; c++) {
     const real *C = b->circ + RHOD_CIRC_STRIDE * c;
     const double d = C[3] * (C[2] - hypot(x - C[0], y - C[1]));
-    if (fabs(d) < fabs(best)) best = d;
+    if (fabs(d) < fabs(best))
+      best = d;
   }
   return best;
 }

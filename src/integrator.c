@@ -11,7 +11,8 @@ int rhod_rk4_init(rhod_rk4 *rk, rhod_particles *p) {
 
 int rhod_rk4_add(rhod_rk4 *rk, rhod_particles *p, real **state, real **deriv, int stride,
                  int offset) {
-  if (rk->nvars >= RHOD_RK_MAX_VARS) return RHOD_ERR_MEMORY;
+  if (rk->nvars >= RHOD_RK_MAX_VARS)
+    return RHOD_ERR_MEMORY;
   const int k = rk->nvars;
   rk->state[k] = state;
   rk->deriv[k] = deriv;
@@ -21,7 +22,8 @@ int rhod_rk4_add(rhod_rk4 *rk, rhod_particles *p, real **state, real **deriv, in
   int st = rhod_particles_add_field(p, "rk_y0", (void **)&rk->y0[k], sizeof(real), 1);
   if (st == RHOD_OK)
     st = rhod_particles_add_field(p, "rk_sum", (void **)&rk->sum[k], sizeof(real), 1);
-  if (st == RHOD_OK) rk->nvars++;
+  if (st == RHOD_OK)
+    rk->nvars++;
   return st;
 }
 
@@ -39,8 +41,8 @@ void rhod_rk4_begin(rhod_rk4 *rk, const rhod_particles *p) {
 }
 
 void rhod_rk4_stage(rhod_rk4 *rk, const rhod_particles *p, int s, real dt) {
-  static const real w[4] = {1, 2, 2, 1};               /* weights x 6 */
-  static const real c[4] = {0.5, 0.5, 1, 0};           /* next stage's fraction of dt */
+  static const real w[4] = {1, 2, 2, 1};     /* weights x 6 */
+  static const real c[4] = {0.5, 0.5, 1, 0}; /* next stage's fraction of dt */
   const long n = (long)p->n;
   const real ws = w[s], cs = c[s] * dt, d6 = dt / 6;
   const int last = s == 3;

@@ -51,10 +51,12 @@ static int mkdir_p(const char *path) {
   for (char *q = tmp + 1; *q; q++)
     if (*q == '/') {
       *q = 0;
-      if (mkdir(tmp, 0755) != 0 && errno != EEXIST) return -1;
+      if (mkdir(tmp, 0755) != 0 && errno != EEXIST)
+        return -1;
       *q = '/';
     }
-  if (mkdir(tmp, 0755) != 0 && errno != EEXIST) return -1;
+  if (mkdir(tmp, 0755) != 0 && errno != EEXIST)
+    return -1;
   struct stat st;
   if (stat(tmp, &st) != 0 || !S_ISDIR(st.st_mode)) {
     errno = ENOTDIR;
@@ -80,7 +82,8 @@ static int check_output_dir(const char *out, char *err, size_t len) {
 }
 
 static void fmt_hms(double s, char *buf, size_t len) {
-  if (!isfinite(s) || s < 0) s = 0;
+  if (!isfinite(s) || s < 0)
+    s = 0;
   long t = (long)(s + 0.5);
   snprintf(buf, len, "%02ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
 }
@@ -109,22 +112,34 @@ static int write_output(run_ctx *c, char *err, size_t len) {
     snprintf(err, len, "out of memory copying the particles for output");
     return st;
   }
-  rhod_snapshot_view v = {.time = s->t, .n = s->p.n, .x = c->hc.x, .y = c->hc.y,
-                          .ux = c->hc.ux, .uy = c->hc.uy, .rho = c->hc.rho, .p = c->hc.p,
-                          .m = c->hc.m, .size = c->hc.dx, .id = c->hc.id, .fs = c->hc.fs};
+  rhod_snapshot_view v = {.time = s->t,
+                          .n = s->p.n,
+                          .x = c->hc.x,
+                          .y = c->hc.y,
+                          .ux = c->hc.ux,
+                          .uy = c->hc.uy,
+                          .rho = c->hc.rho,
+                          .p = c->hc.p,
+                          .m = c->hc.m,
+                          .size = c->hc.dx,
+                          .id = c->hc.id,
+                          .fs = c->hc.fs};
   st = rhod_write_snapshot(c->out, c->nsnap, &v, &c->params, err, len);
-  if (st != RHOD_OK) return st;
+  if (st != RHOD_OK)
+    return st;
   if (c->nsnap >= c->snap_cap) {
     c->snap_cap = 2 * c->snap_cap + 16;
     c->snap_t = realloc(c->snap_t, sizeof(double) * (size_t)c->snap_cap);
     c->snap_n = realloc(c->snap_n, sizeof(size_t) * (size_t)c->snap_cap);
-    if (!c->snap_t || !c->snap_n) return RHOD_ERR_MEMORY;
+    if (!c->snap_t || !c->snap_n)
+      return RHOD_ERR_MEMORY;
   }
   c->snap_t[c->nsnap] = s->t;
   c->snap_n[c->nsnap] = s->p.n;
   c->nsnap++;
   st = rhod_write_xdmf(c->out, c->nsnap, c->snap_t, c->snap_n, err, len);
-  if (st != RHOD_OK) return st;
+  if (st != RHOD_OK)
+    return st;
   char png[4200];
   snprintf(png, sizeof png, "%s/snapshot_%04d.png", c->out, c->nsnap - 1);
   const rhod_scene *sc = c->sc;
@@ -154,7 +169,8 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
   char path[4200], err[ERRLEN];
   snprintf(path, sizeof path, "%s/summary.json", c->out);
   int st = rhod_write_file_atomic(path, buf, err, sizeof err);
-  if (st != RHOD_OK) fprintf(stderr, "rhod: %s\n", err);
+  if (st != RHOD_OK)
+    fprintf(stderr, "rhod: %s\n", err);
   return st;
 }
 
@@ -180,7 +196,8 @@ static int cmd_run(int argc, char **argv) {
       }
       sets[nsets++] = argv[i];
     } else if (!strncmp(argv[i], "--set=", 6)) {
-      if (nsets < 256) sets[nsets++] = argv[i] + 6;
+      if (nsets < 256)
+        sets[nsets++] = argv[i] + 6;
     } else if (argv[i][0] == '-') {
       fprintf(stderr, "rhod: unknown option '%s'\n%s", argv[i], USAGE);
       return RHOD_ERR_USAGE;
@@ -217,7 +234,8 @@ static int cmd_run(int argc, char **argv) {
     }
     snprintf(outbuf, sizeof outbuf, "out/%.1000s", base);
     char *dot = strrchr(outbuf, '.');
-    if (dot && !strcmp(dot, ".yaml")) *dot = 0;
+    if (dot && !strcmp(dot, ".yaml"))
+      *dot = 0;
     out = outbuf;
   }
   c.out = out;
@@ -264,7 +282,8 @@ static int cmd_run(int argc, char **argv) {
   c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
   snprintf(path, sizeof path, "%s/probes.csv", out);
   st = rhod_csv_open(&c.csv, path, c.nprobe_cols, c.probe_names, err, sizeof err);
-  if (st != RHOD_OK) goto fail;
+  if (st != RHOD_OK)
+    goto fail;
   c.csv_open = 1;
 
   const double t_end = c.sc->t_end, dout = c.sc->output_every, dprobe = c.sc->probe_every;
@@ -277,23 +296,31 @@ static int cmd_run(int argc, char **argv) {
     if (s->t >= next_probe - eps || done) {
       rhod_probe_values(s, c.probe_vals);
       st = rhod_csv_row(&c.csv, s->t, c.probe_vals, err, sizeof err);
-      if (st != RHOD_OK) goto fail;
-      while (next_probe <= s->t + eps) next_probe += dprobe;
+      if (st != RHOD_OK)
+        goto fail;
+      while (next_probe <= s->t + eps)
+        next_probe += dprobe;
     }
     if (s->t >= next_out - eps || done) {
       st = write_output(&c, err, sizeof err);
-      if (st != RHOD_OK) goto fail;
+      if (st != RHOD_OK)
+        goto fail;
       logline("rhod: t = %.6g s: snapshot %d (%zu particles)", s->t, c.nsnap - 1, s->p.n);
-      while (next_out <= s->t + eps) next_out += dout;
+      while (next_out <= s->t + eps)
+        next_out += dout;
     }
-    if (done) break;
+    if (done)
+      break;
     double dt = s->dt;
     /* land exactly on output times and on the end */
     const double stop = fmin(t_end, next_out);
-    if (s->t + dt > stop - eps) dt = stop - s->t;
-    else if (s->t + 2 * dt > stop) dt = 0.5 * (stop - s->t);
+    if (s->t + dt > stop - eps)
+      dt = stop - s->t;
+    else if (s->t + 2 * dt > stop)
+      dt = 0.5 * (stop - s->t);
     st = rhod_sim_step(s, dt, err, sizeof err);
-    if (st != RHOD_OK) goto fail;
+    if (st != RHOD_OK)
+      goto fail;
     st = rhod_sim_prepare(s, 1);
     if (st != RHOD_OK) {
       snprintf(err, sizeof err, "out of memory for ghost particles at t = %g s", s->t);
@@ -306,13 +333,15 @@ static int cmd_run(int argc, char **argv) {
       last_decile = (int)(frac * 10);
       char eta[32];
       fmt_hms(frac > 0 ? w * (1 - frac) / frac : 0, eta, sizeof eta);
-      fprintf(stderr, "%st = %.5g s  %5.1f%%  N = %zu  dt = %.3g s  %.3g particle-steps/s  ETA %s%s",
+      fprintf(stderr,
+              "%st = %.5g s  %5.1f%%  N = %zu  dt = %.3g s  %.3g particle-steps/s  ETA %s%s",
               tty ? "\r" : "", s->t, 100 * frac, s->p.n, s->dt,
               (double)s->p.n * (double)s->step / (w > 0 ? w : 1), eta, tty ? "   " : "\n");
       fflush(stderr);
     }
   }
-  if (tty) fprintf(stderr, "\n");
+  if (tty)
+    fprintf(stderr, "\n");
   {
     const double wall = now() - t0;
     const double psteps = (double)s->p.n * (double)s->step;
@@ -322,7 +351,8 @@ static int cmd_run(int argc, char **argv) {
   }
   goto cleanup;
 fail:
-  if (tty) fprintf(stderr, "\n");
+  if (tty)
+    fprintf(stderr, "\n");
   fprintf(stderr, "rhod: %s\n", err);
   if (g_log) {
     fprintf(g_log, "rhod: error: %s\n", err);
@@ -332,7 +362,8 @@ fail:
     char cause[ERRLEN];
     size_t k = 0;
     for (const char *q = err; *q && k < sizeof cause - 2; q++)
-      if (*q != '"' && *q != '\\') cause[k++] = *q;
+      if (*q != '"' && *q != '\\')
+        cause[k++] = *q;
     cause[k] = 0;
     write_summary(&c, st == RHOD_ERR_UNSTABLE ? "unstable" : "error", cause, now() - t0);
     if (st == RHOD_ERR_UNSTABLE)
@@ -347,7 +378,8 @@ cleanup:
       st = RHOD_ERR_IO;
     }
   }
-  if (g_log) fclose(g_log);
+  if (g_log)
+    fclose(g_log);
   g_log = NULL;
   rhod_host_copy_free(&c.hc);
   rhod_param_list_free(&c.params);
@@ -374,7 +406,8 @@ int main(int argc, char **argv) {
     );
     return 0;
   }
-  if (!strcmp(argv[1], "run")) return cmd_run(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "run"))
+    return cmd_run(argc - 2, argv + 2);
   fprintf(stderr, "rhod: unknown command '%s'\n%s", argv[1], USAGE);
   return RHOD_ERR_USAGE;
 }

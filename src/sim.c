@@ -23,7 +23,8 @@ static int in_shape(const rhod_shape *sh, double x, double y) {
 
 static void shape_box(const rhod_shape *sh, double lo[2], double hi[2]) {
   if (sh->kind == RHOD_SHAPE_RECT) {
-    for (int a = 0; a < 2; a++) lo[a] = sh->min[a], hi[a] = sh->max[a];
+    for (int a = 0; a < 2; a++)
+      lo[a] = sh->min[a], hi[a] = sh->max[a];
   } else if (sh->kind == RHOD_SHAPE_CIRCLE) {
     for (int a = 0; a < 2; a++)
       lo[a] = sh->center[a] - sh->radius, hi[a] = sh->center[a] + sh->radius;
@@ -51,7 +52,8 @@ static double shape_top(const rhod_shape *sh, double ex, double ey) {
   shape_box(sh, lo, hi);
   const double cx[2] = {lo[0], hi[0]}, cy[2] = {lo[1], hi[1]};
   for (int a = 0; a < 2; a++)
-    for (int b = 0; b < 2; b++) best = fmax(best, cx[a] * ex + cy[b] * ey);
+    for (int b = 0; b < 2; b++)
+      best = fmax(best, cx[a] * ex + cy[b] * ey);
   return best;
 }
 
@@ -74,12 +76,17 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
       for (long j = 0; j < ny; j++)
         for (long i = 0; i < nx; i++) {
           const double x = lo[0] + (i + 0.5) * dx, y = lo[1] + (j + 0.5) * dx;
-          if (!in_shape(&B->shape, x, y)) continue;
+          if (!in_shape(&B->shape, x, y))
+            continue;
           int taken = 0; /* a point of an earlier block is not filled twice */
-          for (unsigned e = 0; e < b && !taken; e++) taken = in_shape(&sc->fluid[e].shape, x, y);
-          if (taken) continue;
-          if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1]) continue;
-          if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0) continue;
+          for (unsigned e = 0; e < b && !taken; e++)
+            taken = in_shape(&sc->fluid[e].shape, x, y);
+          if (taken)
+            continue;
+          if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1])
+            continue;
+          if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0)
+            continue;
           if (pass == 1) {
             rhod_particles *p = &s->p;
             double P = 0;
@@ -108,8 +115,8 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
         return RHOD_ERR_SCENE;
       }
       if (n > 2000000000u) {
-        snprintf(err, errlen, "%s: particles.dx: %zu particles is more than supported",
-                 sc->path, n);
+        snprintf(err, errlen, "%s: particles.dx: %zu particles is more than supported", sc->path,
+                 n);
         return RHOD_ERR_SCENE;
       }
       int st = rhod_particles_reserve(&s->p, n + n / 2 + 256);
@@ -129,7 +136,8 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   memset(s, 0, sizeof *s);
   s->sc = sc;
   if (sc->has_domain) {
-    for (int a = 0; a < 2; a++) s->lo[a] = sc->domain_min[a], s->hi[a] = sc->domain_max[a];
+    for (int a = 0; a < 2; a++)
+      s->lo[a] = sc->domain_min[a], s->hi[a] = sc->domain_max[a];
   } else {
     s->lo[0] = s->lo[1] = HUGE_VAL;
     s->hi[0] = s->hi[1] = -HUGE_VAL;
@@ -138,35 +146,45 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
       const rhod_shape *sh =
           k < sc->n_fluid ? &sc->fluid[k].shape : &sc->walls[k - sc->n_fluid].shape;
       shape_box(sh, lo, hi);
-      for (int a = 0; a < 2; a++) s->lo[a] = fmin(s->lo[a], lo[a]), s->hi[a] = fmax(s->hi[a], hi[a]);
+      for (int a = 0; a < 2; a++)
+        s->lo[a] = fmin(s->lo[a], lo[a]), s->hi[a] = fmax(s->hi[a], hi[a]);
     }
   }
   s->margin = sc->radius_ratio * sc->dx;
   int st = rhod_particles_init(&s->p, 1024);
-  if (st == RHOD_OK) st = rhod_boundary_init(&s->bnd, sc, s->lo, s->hi);
+  if (st == RHOD_OK)
+    st = rhod_boundary_init(&s->bnd, sc, s->lo, s->hi);
   if (st != RHOD_OK) {
     snprintf(err, errlen, "out of memory setting up the particles");
     return st;
   }
   /* host-side fill happens before anything is sent to the device */
   st = fill_fluid(s, err, errlen);
-  if (st != RHOD_OK) return st;
+  if (st != RHOD_OK)
+    return st;
   st = rhod_sph_init(&s->sph, sc, &s->p);
-  if (st == RHOD_OK) st = rhod_rk4_init(&s->rk, &s->p);
+  if (st == RHOD_OK)
+    st = rhod_rk4_init(&s->rk, &s->p);
   rhod_particles *p = &s->p;
   rhod_sph *h = &s->sph;
-  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->x, &h->vel, 2, 0);
-  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->y, &h->vel, 2, 1);
-  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->ux, &h->acc, 2, 0);
-  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->uy, &h->acc, 2, 1);
-  if (st == RHOD_OK) st = rhod_rk4_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
+  if (st == RHOD_OK)
+    st = rhod_rk4_add(&s->rk, p, &p->x, &h->vel, 2, 0);
+  if (st == RHOD_OK)
+    st = rhod_rk4_add(&s->rk, p, &p->y, &h->vel, 2, 1);
+  if (st == RHOD_OK)
+    st = rhod_rk4_add(&s->rk, p, &p->ux, &h->acc, 2, 0);
+  if (st == RHOD_OK)
+    st = rhod_rk4_add(&s->rk, p, &p->uy, &h->acc, 2, 1);
+  if (st == RHOD_OK)
+    st = rhod_rk4_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
   if (st != RHOD_OK) {
     snprintf(err, errlen, "out of memory setting up the scheme");
     return st;
   }
   /* the persistent state goes to the device */
   for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent) rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+    if (p->fields[f].persistent)
+      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
   const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
   const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
   st = rhod_cells_init(&s->cells, glo, ghi, s->margin, p->cap);
@@ -190,18 +208,23 @@ static void wrap_periodic(rhod_sim *s) {
   const long n = (long)p->n;
   real *x = p->x, *y = p->y;
   const int px = s->bnd.periodic[0], py = s->bnd.periodic[1];
-  if (!px && !py) return;
+  if (!px && !py)
+    return;
   const real lox = (real)s->lo[0], loy = (real)s->lo[1];
   const real Lx = (real)(s->hi[0] - s->lo[0]), Ly = (real)(s->hi[1] - s->lo[1]);
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     if (px) {
-      if (x[i] < lox) x[i] += Lx;
-      else if (x[i] >= lox + Lx) x[i] -= Lx;
+      if (x[i] < lox)
+        x[i] += Lx;
+      else if (x[i] >= lox + Lx)
+        x[i] -= Lx;
     }
     if (py) {
-      if (y[i] < loy) y[i] += Ly;
-      else if (y[i] >= loy + Ly) y[i] -= Ly;
+      if (y[i] < loy)
+        y[i] += Ly;
+      else if (y[i] >= loy + Ly)
+        y[i] -= Ly;
     }
   }
 }
@@ -211,19 +234,23 @@ int rhod_sim_prepare(rhod_sim *s, int sort) {
   if (sort) {
     wrap_periodic(s);
     p->ng = 0;
-    if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK) return RHOD_ERR_MEMORY;
+    if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK)
+      return RHOD_ERR_MEMORY;
     rhod_cells_build(&s->cells, p->x, p->y, p->n);
     /* the fluid part of the cell order is the new particle order */
     int32_t *perm = p->perm;
     const int32_t *idx = s->cells.idx;
     const long n = (long)p->n;
     RHOD_KERNEL_LOOP
-    for (long k = 0; k < n; k++) perm[k] = idx[k];
+    for (long k = 0; k < n; k++)
+      perm[k] = idx[k];
     rhod_particles_permute(p);
   }
   int st = rhod_ghosts_build(&s->bnd, p, (real)s->sc->radius_ratio, (real)s->margin);
-  if (st != RHOD_OK) return st;
-  if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK) return RHOD_ERR_MEMORY;
+  if (st != RHOD_OK)
+    return st;
+  if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK)
+    return RHOD_ERR_MEMORY;
   rhod_sph_fill_state(&s->sph, p);
   rhod_cells_build(&s->cells, p->x, p->y, p->n + p->ng);
   s->neighbours_fresh = 1;
@@ -235,21 +262,21 @@ static int check_state(rhod_sim *s, char *err, size_t errlen) {
   rhod_particles *p = &s->p;
   const long n = (long)p->n;
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho;
-  const real lox = (real)s->lo[0], hix = (real)s->hi[0], loy = (real)s->lo[1],
-             hiy = (real)s->hi[1];
+  const real lox = (real)s->lo[0], hix = (real)s->hi[0], loy = (real)s->lo[1], hiy = (real)s->hi[1];
   const int px = s->bnd.periodic[0], py = s->bnd.periodic[1];
   /* periodic axes may sit up to one step outside before the wrap */
   const real mx = px ? (real)s->margin : 0, my = py ? (real)s->margin : 0;
   long bad = n;
   RHOD_KERNEL_LOOP_REDUCE(min, bad)
   for (long i = 0; i < n; i++) {
-    const int finite = isfinite(x[i]) && isfinite(y[i]) && isfinite(ux[i]) &&
-                       isfinite(uy[i]) && isfinite(rho[i]) && rho[i] > 0;
-    const int inside = x[i] >= lox - mx && x[i] <= hix + mx && y[i] >= loy - my &&
-                       y[i] <= hiy + my;
-    if (!(finite && inside) && i < bad) bad = i;
+    const int finite = isfinite(x[i]) && isfinite(y[i]) && isfinite(ux[i]) && isfinite(uy[i]) &&
+                       isfinite(rho[i]) && rho[i] > 0;
+    const int inside = x[i] >= lox - mx && x[i] <= hix + mx && y[i] >= loy - my && y[i] <= hiy + my;
+    if (!(finite && inside) && i < bad)
+      bad = i;
   }
-  if (bad == n) return RHOD_OK;
+  if (bad == n)
+    return RHOD_OK;
   real v[5];
   rhod_to_host(p->x + bad, sizeof(real));
   rhod_to_host(p->y + bad, sizeof(real));
@@ -260,10 +287,14 @@ static int check_state(rhod_sim *s, char *err, size_t errlen) {
   v[0] = p->x[bad], v[1] = p->y[bad], v[2] = p->ux[bad], v[3] = p->uy[bad], v[4] = p->rho[bad];
   const unsigned long long id = (unsigned long long)p->id[bad];
   const char *what;
-  if (!isfinite(v[4]) || !(v[4] > 0)) what = "density is not finite and positive";
-  else if (!isfinite(v[2]) || !isfinite(v[3])) what = "velocity is not finite";
-  else if (!isfinite(v[0]) || !isfinite(v[1])) what = "position is not finite";
-  else what = "left the domain";
+  if (!isfinite(v[4]) || !(v[4] > 0))
+    what = "density is not finite and positive";
+  else if (!isfinite(v[2]) || !isfinite(v[3]))
+    what = "velocity is not finite";
+  else if (!isfinite(v[0]) || !isfinite(v[1]))
+    what = "position is not finite";
+  else
+    what = "left the domain";
   snprintf(err, errlen,
            "unstable at t = %.6g s (step %ld): particle id %llu %s (x = %g, y = %g, u = %g, "
            "v = %g, rho = %g)",
@@ -277,13 +308,15 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   int st;
   if (!s->neighbours_fresh) {
     st = rhod_sim_prepare(s, 1);
-    if (st != RHOD_OK) goto mem;
+    if (st != RHOD_OK)
+      goto mem;
   }
   rhod_rk4_begin(&s->rk, p);
   for (int stage = 0; stage < 4; stage++) {
     if (stage > 0) {
       st = rhod_sim_prepare(s, 0);
-      if (st != RHOD_OK) goto mem;
+      if (st != RHOD_OK)
+        goto mem;
     }
     rhod_sph_rhs(&s->sph, p, &s->cells, (real)dt);
     rhod_rk4_stage(&s->rk, p, stage, (real)dt);
@@ -300,13 +333,20 @@ mem:
 
 static const char *probe_kind_name(rhod_probe_kind k) {
   switch (k) {
-  case RHOD_PROBE_PRESSURE: return "pressure";
-  case RHOD_PROBE_KINETIC_ENERGY: return "kinetic_energy";
-  case RHOD_PROBE_POTENTIAL_ENERGY: return "potential_energy";
-  case RHOD_PROBE_FRONT: return "front";
-  case RHOD_PROBE_MASS: return "mass";
-  case RHOD_PROBE_MOMENTUM: return "momentum";
-  case RHOD_PROBE_ANGULAR_MOMENTUM: return "angular_momentum";
+  case RHOD_PROBE_PRESSURE:
+    return "pressure";
+  case RHOD_PROBE_KINETIC_ENERGY:
+    return "kinetic_energy";
+  case RHOD_PROBE_POTENTIAL_ENERGY:
+    return "potential_energy";
+  case RHOD_PROBE_FRONT:
+    return "front";
+  case RHOD_PROBE_MASS:
+    return "mass";
+  case RHOD_PROBE_MOMENTUM:
+    return "momentum";
+  case RHOD_PROBE_ANGULAR_MOMENTUM:
+    return "angular_momentum";
   }
   return "probe";
 }
@@ -362,14 +402,16 @@ void rhod_probe_values(rhod_sim *s, double *values) {
     case RHOD_PROBE_KINETIC_ENERGY: {
       real e = 0;
       RHOD_KERNEL_LOOP_REDUCE(+, e)
-      for (long j = 0; j < n; j++) e += (real)0.5 * m[j] * (ux[j] * ux[j] + uy[j] * uy[j]);
+      for (long j = 0; j < n; j++)
+        e += (real)0.5 * m[j] * (ux[j] * ux[j] + uy[j] * uy[j]);
       values[k++] = e;
       break;
     }
     case RHOD_PROBE_POTENTIAL_ENERGY: {
       real e = 0;
       RHOD_KERNEL_LOOP_REDUCE(+, e)
-      for (long j = 0; j < n; j++) e -= m[j] * (gx * x[j] + gy * y[j]);
+      for (long j = 0; j < n; j++)
+        e -= m[j] * (gx * x[j] + gy * y[j]);
       values[k++] = e;
       break;
     }
@@ -386,14 +428,16 @@ void rhod_probe_values(rhod_sim *s, double *values) {
     case RHOD_PROBE_MASS: {
       real e = 0;
       RHOD_KERNEL_LOOP_REDUCE(+, e)
-      for (long j = 0; j < n; j++) e += m[j];
+      for (long j = 0; j < n; j++)
+        e += m[j];
       values[k++] = e;
       break;
     }
     case RHOD_PROBE_MOMENTUM: {
       real a = 0, b = 0;
       RHOD_KERNEL_LOOP_REDUCE2(+, a, b)
-      for (long j = 0; j < n; j++) a += m[j] * ux[j], b += m[j] * uy[j];
+      for (long j = 0; j < n; j++)
+        a += m[j] * ux[j], b += m[j] * uy[j];
       values[k++] = a;
       values[k++] = b;
       break;
@@ -401,7 +445,8 @@ void rhod_probe_values(rhod_sim *s, double *values) {
     case RHOD_PROBE_ANGULAR_MOMENTUM: {
       real a = 0;
       RHOD_KERNEL_LOOP_REDUCE(+, a)
-      for (long j = 0; j < n; j++) a += m[j] * ((x[j] - ax) * uy[j] - (y[j] - ay) * ux[j]);
+      for (long j = 0; j < n; j++)
+        a += m[j] * ((x[j] - ax) * uy[j] - (y[j] - ay) * ux[j]);
       values[k++] = a;
       break;
     }
@@ -416,8 +461,16 @@ int rhod_sim_fetch(rhod_sim *s, rhod_host_copy *h) {
     rhod_host_copy_free(h);
     h->cap = n + n / 4 + 16;
 #define A(f, t) h->f = malloc(h->cap * sizeof(t))
-    A(x, real); A(y, real); A(ux, real); A(uy, real); A(rho, real); A(p, real); A(m, real);
-    A(dx, real); A(id, uint64_t); A(fs, uint8_t);
+    A(x, real);
+    A(y, real);
+    A(ux, real);
+    A(uy, real);
+    A(rho, real);
+    A(p, real);
+    A(m, real);
+    A(dx, real);
+    A(id, uint64_t);
+    A(fs, uint8_t);
 #undef A
     if (!h->x || !h->y || !h->ux || !h->uy || !h->rho || !h->p || !h->m || !h->dx || !h->id ||
         !h->fs)

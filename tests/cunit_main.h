@@ -11,11 +11,14 @@ typedef struct {
 } rhod_test_case;
 
 static inline int rhod_test_main(const char *suite, const rhod_test_case *cases, int n) {
-  if (CU_initialize_registry() != CUE_SUCCESS) return 2;
+  if (CU_initialize_registry() != CUE_SUCCESS)
+    return 2;
   CU_pSuite s = CU_add_suite(suite, NULL, NULL);
-  if (!s) return 2;
+  if (!s)
+    return 2;
   for (int i = 0; i < n; i++)
-    if (!CU_add_test(s, cases[i].name, cases[i].fn)) return 2;
+    if (!CU_add_test(s, cases[i].name, cases[i].fn))
+      return 2;
   CU_basic_set_mode(CU_BRM_VERBOSE);
   CU_basic_run_tests();
   unsigned failed = CU_get_number_of_failures() + CU_get_number_of_tests_failed();

@@ -18,9 +18,9 @@
 
 typedef struct {
   int nseg, ncorner, ncirc;
-  real *seg;        /* nseg * RHOD_SEG_STRIDE; n is the normal pointing into the fluid */
-  int32_t *corner;  /* ncorner * 2: segments meeting at a corner that needs a double mirror */
-  real *circ;       /* ncirc * RHOD_CIRC_STRIDE */
+  real *seg;       /* nseg * RHOD_SEG_STRIDE; n is the normal pointing into the fluid */
+  int32_t *corner; /* ncorner * 2: segments meeting at a corner that needs a double mirror */
+  real *circ;      /* ncirc * RHOD_CIRC_STRIDE */
   int periodic[2];
   double lo[2], hi[2]; /* domain box */
   int32_t *count;      /* per-particle ghost counts (scan buffer), cap + 1 */

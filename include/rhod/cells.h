@@ -13,8 +13,8 @@
 
 /* Grid geometry, plain values: safe to pass by value into device regions. */
 typedef struct {
-  real ox, oy;  /* lower-left corner */
-  real inv;     /* 1 / cell */
+  real ox, oy; /* lower-left corner */
+  real inv;    /* 1 / cell */
   int nx, ny;
 } rhod_grid;
 
@@ -29,8 +29,7 @@ typedef struct {
 } rhod_cells;
 
 /* Sets up a grid over [lo, hi] with cells of side >= cell. */
-int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double cell,
-                    size_t cap);
+int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double cell, size_t cap);
 int rhod_cells_reserve(rhod_cells *c, size_t cap);
 void rhod_cells_free(rhod_cells *c);
 /* Sorts particles [0, count) into the cells (positions on the device). Particles
@@ -51,19 +50,19 @@ static inline int rhod_cell_coord(real v, real o, real inv, int n) {
  *
  * j runs over every particle (fluid and ghost, i itself included) in the 3x3 cells
  * around (xi, yi); the body tests the distance against its own radius. */
-#define RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j)                                         \
-  {                                                                                       \
-    const int cx_ = rhod_cell_coord((xi), (G).ox, (G).inv, (G).nx);                       \
-    const int cy_ = rhod_cell_coord((yi), (G).oy, (G).inv, (G).ny);                       \
-    const int y0_ = cy_ > 0 ? cy_ - 1 : 0, y1_ = cy_ < (G).ny - 1 ? cy_ + 1 : cy_;        \
-    const int x0_ = cx_ > 0 ? cx_ - 1 : 0, x1_ = cx_ < (G).nx - 1 ? cx_ + 1 : cx_;        \
-    for (int yy_ = y0_; yy_ <= y1_; yy_++) {                                              \
-      const int k0_ = (CS)[yy_ * (G).nx + x0_], k1_ = (CS)[yy_ * (G).nx + x1_ + 1];       \
-      for (int k_ = k0_; k_ < k1_; k_++) {                                                \
+#define RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j)                                                  \
+  {                                                                                                \
+    const int cx_ = rhod_cell_coord((xi), (G).ox, (G).inv, (G).nx);                                \
+    const int cy_ = rhod_cell_coord((yi), (G).oy, (G).inv, (G).ny);                                \
+    const int y0_ = cy_ > 0 ? cy_ - 1 : 0, y1_ = cy_ < (G).ny - 1 ? cy_ + 1 : cy_;                 \
+    const int x0_ = cx_ > 0 ? cx_ - 1 : 0, x1_ = cx_ < (G).nx - 1 ? cx_ + 1 : cx_;                 \
+    for (int yy_ = y0_; yy_ <= y1_; yy_++) {                                                       \
+      const int k0_ = (CS)[yy_ * (G).nx + x0_], k1_ = (CS)[yy_ * (G).nx + x1_ + 1];                \
+      for (int k_ = k0_; k_ < k1_; k_++) {                                                         \
         const int j = (CI)[k_];
-#define RHOD_END_NEIGHBOURS                                                               \
-  }                                                                                       \
-  }                                                                                       \
+#define RHOD_END_NEIGHBOURS                                                                        \
+  }                                                                                                \
+  }                                                                                                \
   }
 
 /* Exclusive prefix sum of n ints in place on the device; returns the total. */

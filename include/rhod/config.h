@@ -25,16 +25,16 @@ typedef double real;
 #ifdef RHOD_OFFLOAD
 #define RHOD_PRAGMA(x) _Pragma(#x)
 #define RHOD_KERNEL_LOOP RHOD_PRAGMA(omp target teams distribute parallel for simd)
-#define RHOD_KERNEL_LOOP_REDUCE(op, var)                                                  \
+#define RHOD_KERNEL_LOOP_REDUCE(op, var)                                                           \
   RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : var))
-#define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                              \
+#define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                                       \
   RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : v1, v2))
 #else
 #define RHOD_PRAGMA(x) _Pragma(#x)
 #define RHOD_KERNEL_LOOP RHOD_PRAGMA(omp parallel for schedule(static))
-#define RHOD_KERNEL_LOOP_REDUCE(op, var)                                                  \
+#define RHOD_KERNEL_LOOP_REDUCE(op, var)                                                           \
   RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : var))
-#define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                              \
+#define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                                       \
   RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : v1, v2))
 #endif
 

@@ -14,14 +14,14 @@
 typedef struct {
   double time;
   size_t n;
-  const real *x, *y;      /* positions [m] */
-  const real *ux, *uy;    /* velocities [m/s] */
-  const real *rho;        /* density [kg/m^3] */
-  const real *p;          /* pressure [Pa] */
-  const real *m;          /* mass [kg/m] */
-  const real *size;       /* particle size dx_i [m] */
-  const uint64_t *id;     /* persistent particle id */
-  const uint8_t *fs;      /* free-surface flag (1: in F), may be NULL */
+  const real *x, *y;   /* positions [m] */
+  const real *ux, *uy; /* velocities [m/s] */
+  const real *rho;     /* density [kg/m^3] */
+  const real *p;       /* pressure [Pa] */
+  const real *m;       /* mass [kg/m] */
+  const real *size;    /* particle size dx_i [m] */
+  const uint64_t *id;  /* persistent particle id */
+  const uint8_t *fs;   /* free-surface flag (1: in F), may be NULL */
 } rhod_snapshot_view;
 
 /* OUT/snapshot_NNNN.h5: /Header attrs Time, Dimension (2), NumPart; /PartType0 datasets
@@ -42,9 +42,9 @@ typedef struct {
   size_t n;
   double *x, *y, *ux, *uy, *rho, *p, *m, *size;
   uint64_t *id;
-  uint8_t *fs;             /* FreeSurface, NULL when the file has none */
-  rhod_param_list params;  /* /Parameters in file order; owned here, freed by
-                              rhod_snapshot_data_free (not rhod_param_list_free) */
+  uint8_t *fs;            /* FreeSurface, NULL when the file has none */
+  rhod_param_list params; /* /Parameters in file order; owned here, freed by
+                             rhod_snapshot_data_free (not rhod_param_list_free) */
 } rhod_snapshot_data;
 int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen);
 void rhod_snapshot_data_free(rhod_snapshot_data *d);
@@ -62,8 +62,8 @@ int rhod_write_xdmf(const char *dir, int count, const double *times, const size_
  * pixels wide; below the frame is a strip with the bar and labels. Errors: RHOD_ERR_SCENE
  * (empty frame, width or height outside 1..16384), RHOD_ERR_IO (cannot write). */
 int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
-                       unsigned width, const double lo[2], const double hi[2],
-                       const double *range, char *err, size_t errlen);
+                       unsigned width, const double lo[2], const double hi[2], const double *range,
+                       char *err, size_t errlen);
 
 /* probes.csv: a header row (first column t) then one row per sample. The file is kept
  * open and flushed after every row. */

@@ -15,15 +15,15 @@
 
 typedef struct {
   const char *name;
-  void **ptr;       /* address of the owner's pointer variable */
-  size_t elem;      /* bytes per particle */
-  int persistent;   /* 1: carried across steps and reordered with the particles */
+  void **ptr;     /* address of the owner's pointer variable */
+  size_t elem;    /* bytes per particle */
+  int persistent; /* 1: carried across steps and reordered with the particles */
 } rhod_field_desc;
 
 typedef struct {
-  size_t n;    /* fluid particles */
-  size_t ng;   /* ghosts after the fluid */
-  size_t cap;  /* allocated particles (fluid + ghosts) */
+  size_t n;   /* fluid particles */
+  size_t ng;  /* ghosts after the fluid */
+  size_t cap; /* allocated particles (fluid + ghosts) */
   /* persistent state */
   real *x, *y, *ux, *uy, *rho, *m, *dx;
   uint64_t *id;

@@ -21,10 +21,10 @@ typedef enum { RHOD_SHAPE_RECT = 0, RHOD_SHAPE_POLYGON, RHOD_SHAPE_CIRCLE } rhod
 
 typedef struct {
   rhod_shape_kind kind;
-  double min[2], max[2];       /* RECT: lower-left and upper-right corners [m] */
-  double center[2], radius;    /* CIRCLE [m] */
-  double (*points)[2];         /* POLYGON: vertices [m], closed implicitly */
-  unsigned n_points;           /* POLYGON: at least 3 */
+  double min[2], max[2];    /* RECT: lower-left and upper-right corners [m] */
+  double center[2], radius; /* CIRCLE [m] */
+  double (*points)[2];      /* POLYGON: vertices [m], closed implicitly */
+  unsigned n_points;        /* POLYGON: at least 3 */
 } rhod_shape;
 
 typedef enum { RHOD_INIT_UNIFORM = 0, RHOD_INIT_HYDROSTATIC } rhod_init_kind;
@@ -32,9 +32,9 @@ typedef enum { RHOD_INIT_UNIFORM = 0, RHOD_INIT_HYDROSTATIC } rhod_init_kind;
 /* A block of fluid filled with a square lattice of spacing particles.dx. */
 typedef struct {
   rhod_shape shape;
-  double velocity[2];        /* initial velocity [m/s], default 0 */
-  rhod_init_kind pressure;   /* uniform (P = 0) or hydrostatic (paper 002 Sec. VI A,
-                                free surface at the block's highest point along -g) */
+  double velocity[2];      /* initial velocity [m/s], default 0 */
+  rhod_init_kind pressure; /* uniform (P = 0) or hydrostatic (paper 002 Sec. VI A,
+                              free surface at the block's highest point along -g) */
 } rhod_fluid_block;
 
 typedef enum { RHOD_SLIP_FREE = 0, RHOD_SLIP_NO } rhod_slip;
@@ -47,23 +47,27 @@ typedef struct {
 } rhod_wall;
 
 typedef enum {
-  RHOD_PROBE_PRESSURE = 0,   /* Shepard-interpolated pressure at a point [Pa] */
-  RHOD_PROBE_KINETIC_ENERGY, /* sum 1/2 m |u|^2 [J/m] */
+  RHOD_PROBE_PRESSURE = 0,     /* Shepard-interpolated pressure at a point [Pa] */
+  RHOD_PROBE_KINETIC_ENERGY,   /* sum 1/2 m |u|^2 [J/m] */
   RHOD_PROBE_POTENTIAL_ENERGY, /* sum -m g.x [J/m] */
-  RHOD_PROBE_FRONT,          /* max over fluid of x.direction [m] */
-  RHOD_PROBE_MASS,           /* sum m [kg/m] */
-  RHOD_PROBE_MOMENTUM,       /* sum m u, two columns name_x, name_y [kg/s] */
-  RHOD_PROBE_ANGULAR_MOMENTUM /* sum m (x - at) x u [kg m/s] */
+  RHOD_PROBE_FRONT,            /* max over fluid of x.direction [m] */
+  RHOD_PROBE_MASS,             /* sum m [kg/m] */
+  RHOD_PROBE_MOMENTUM,         /* sum m u, two columns name_x, name_y [kg/s] */
+  RHOD_PROBE_ANGULAR_MOMENTUM  /* sum m (x - at) x u [kg m/s] */
 } rhod_probe_kind;
 
 typedef struct {
   rhod_probe_kind kind;
-  char *name;           /* CSV column name; default: the kind's name */
-  double at[2];         /* PRESSURE: the point; ANGULAR_MOMENTUM: the origin */
-  double direction[2];  /* FRONT: unit direction, default [1, 0] */
+  char *name;          /* CSV column name; default: the kind's name */
+  double at[2];        /* PRESSURE: the point; ANGULAR_MOMENTUM: the origin */
+  double direction[2]; /* FRONT: unit direction, default [1, 0] */
 } rhod_probe;
 
-typedef enum { RHOD_KERNEL_WENDLAND_C2 = 0, RHOD_KERNEL_WENDLAND_C4, RHOD_KERNEL_QUINTIC } rhod_kernel_kind;
+typedef enum {
+  RHOD_KERNEL_WENDLAND_C2 = 0,
+  RHOD_KERNEL_WENDLAND_C4,
+  RHOD_KERNEL_QUINTIC
+} rhod_kernel_kind;
 
 typedef enum {
   RHOD_FIELD_PRESSURE = 0,
@@ -75,51 +79,54 @@ typedef enum {
 
 typedef struct {
   /* time: */
-  double t_end;          /* time.end [s] (required) */
-  double output_every;   /* time.output_every [s] (required) */
-  double cfl;            /* time.cfl, CFL_h of Eq. 11, default 0.5 */
-  double cfl_visc;       /* time.cfl_visc, CFL_mu of Eq. 11, default 0.025 */
+  double t_end;        /* time.end [s] (required) */
+  double output_every; /* time.output_every [s] (required) */
+  double cfl;          /* time.cfl, CFL_h of Eq. 11, default 0.5 */
+  double cfl_visc;     /* time.cfl_visc, CFL_mu of Eq. 11, default 0.025 */
   /* particles: */
-  double dx;             /* particles.dx [m] (required) */
-  double radius_ratio;   /* particles.radius_ratio = R/dx, default 4 (paper 002 Sec. IV D) */
+  double dx;               /* particles.dx [m] (required) */
+  double radius_ratio;     /* particles.radius_ratio = R/dx, default 4 (paper 002 Sec. IV D) */
   rhod_kernel_kind kernel; /* particles.kernel, default wendland_c2 */
   /* physics: */
-  double rho0;           /* physics.rho0 [kg/m^3], default 1000 */
-  double c0;             /* physics.c0 [m/s] (required), Eq. 2 */
-  double mu;             /* physics.mu [Pa s], default 0 (inviscid) */
-  double gravity[2];     /* physics.gravity [m/s^2], default [0, 0] */
+  double rho0;       /* physics.rho0 [kg/m^3], default 1000 */
+  double c0;         /* physics.c0 [m/s] (required), Eq. 2 */
+  double mu;         /* physics.mu [Pa s], default 0 (inviscid) */
+  double gravity[2]; /* physics.gravity [m/s^2], default [0, 0] */
   /* scheme (paper 002 Sec. IV A; each switch defaults to on): */
-  int riemann;           /* scheme.riemann: Theta^rho and Theta^u, Eqs. 23-24 */
-  int reconstruction;    /* scheme.reconstruction: limited linear states Eqs. 13-16
-                            (off: first order, phi_L = phi_i) */
-  int shifting;          /* scheme.shifting: Eqs. 25-29 and the Eq. 4 terms */
+  int riemann;                        /* scheme.riemann: Theta^rho and Theta^u, Eqs. 23-24 */
+  int reconstruction;                 /* scheme.reconstruction: limited linear states Eqs. 13-16
+                                         (off: first order, phi_L = phi_i) */
+  int shifting;                       /* scheme.shifting: Eqs. 25-29 and the Eq. 4 terms */
   double shift_a, shift_b, shift_eps; /* scheme.shifting_a/b/eps: 0.5, 0.05, 5e-4 (Eq. 27) */
-  int acoustic_damper;   /* scheme.acoustic_damper: Eq. 9 */
-  double alpha_ad;       /* scheme.alpha_ad: 1 */
-  int free_surface;      /* scheme.free_surface: detection of Ref. 51 and the Eq. 6 switch;
-                            off: every particle is inner */
+  int acoustic_damper;                /* scheme.acoustic_damper: Eq. 9 */
+  double alpha_ad;                    /* scheme.alpha_ad: 1 */
+  int free_surface; /* scheme.free_surface: detection of Ref. 51 and the Eq. 6 switch;
+                       off: every particle is inner */
   double fs_lambda_low, fs_lambda_high; /* scheme.free_surface_lambda: [0.2, 0.75] */
-  double shepard_threshold; /* scheme.shepard_threshold: Gamma_th = 0.85 (Eq. 6) */
-  double theta_threshold;   /* scheme.theta_threshold: 0.95 (Eq. 24) */
+  double shepard_threshold;             /* scheme.shepard_threshold: Gamma_th = 0.85 (Eq. 6) */
+  double theta_threshold;               /* scheme.theta_threshold: 0.95 (Eq. 24) */
   /* domain (default: the bounding box of walls and fluid): */
   int has_domain;
   double domain_min[2], domain_max[2];
-  int periodic[2];          /* domain.periodic: [false, false] */
+  int periodic[2]; /* domain.periodic: [false, false] */
   /* geometry: */
-  rhod_fluid_block *fluid; unsigned n_fluid;
-  rhod_wall *walls; unsigned n_walls;
-  rhod_probe *probes; unsigned n_probes;
-  double probe_every;    /* probes.every [s]: sampling interval, default output_every/10 */
+  rhod_fluid_block *fluid;
+  unsigned n_fluid;
+  rhod_wall *walls;
+  unsigned n_walls;
+  rhod_probe *probes;
+  unsigned n_probes;
+  double probe_every; /* probes.every [s]: sampling interval, default output_every/10 */
   /* output: */
   rhod_field picture_field; /* output.picture.field, default pressure */
   unsigned picture_width;   /* output.picture.width [pixels], default 800 */
   int picture_range_set;
-  double picture_range[2];  /* output.picture.range: colour scale limits (default: auto) */
+  double picture_range[2]; /* output.picture.range: colour scale limits (default: auto) */
   /* bookkeeping */
-  char *name;            /* name: default the file's base name without extension (the
-                            folder's name for a file called scene.yaml) */
-  char *path;            /* the file it was loaded from */
-  char *yaml;            /* the scene as run (all keys, defaults filled), YAML text */
+  char *name; /* name: default the file's base name without extension (the
+                 folder's name for a file called scene.yaml) */
+  char *path; /* the file it was loaded from */
+  char *yaml; /* the scene as run (all keys, defaults filled), YAML text */
 } rhod_scene;
 
 /* Loads a scene from `path`, applying `--set key=value` overrides (dotted keys) in order.

@@ -21,7 +21,7 @@ typedef struct {
   double margin;       /* ghost layer width: largest kernel radius */
   double t, dt;
   long step;
-  long reflected; /* particles put back by the wall-crossing guard, whole run */
+  long reflected;       /* particles put back by the wall-crossing guard, whole run */
   int neighbours_fresh; /* ghosts and cells match the current state */
 } rhod_sim;
 

@@ -11,27 +11,27 @@
 typedef struct {
   /* parameters (from the scene) */
   int kernel;
-  real ratio;              /* R/dx */
+  real ratio; /* R/dx */
   real rho0, c0, mu, gx, gy;
   real cfl, cfl_visc;
   int riemann, recon, shifting, damper, fsdetect;
   real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
   /* per-particle fields (scratch, rebuilt each stage) */
   real *P, *V;
-  real *gam, *ggam;  /* Shepard Gamma (Eq. 7) and its gradient (Eq. 27), 2 */
-  real *L;           /* renormalisation matrix (Eq. 8), 4, row-major */
-  real *gP, *gu;     /* renormalised gradients (Eq. 14) of P (2) and u (4: dux/dx,
-                        dux/dy, duy/dx, duy/dy) */
-  real *D;           /* velocity divergence (Eq. 5) */
-  real *gC;          /* concentration gradient (Eq. 29), 2 */
-  real *uch;         /* U_char (after Eq. 27) */
-  real *lam;         /* smallest eigenvalue of sym(L^-1) */
-  real *nrm;         /* free-surface normal, 2 */
-  real *nt, *sig;    /* shifting projection normal and weight (Eq. 26), 2 and 1 */
-  real *du;          /* shifting velocity (Eq. 27), 2 */
+  real *gam, *ggam;       /* Shepard Gamma (Eq. 7) and its gradient (Eq. 27), 2 */
+  real *L;                /* renormalisation matrix (Eq. 8), 4, row-major */
+  real *gP, *gu;          /* renormalised gradients (Eq. 14) of P (2) and u (4: dux/dx,
+                             dux/dy, duy/dx, duy/dy) */
+  real *D;                /* velocity divergence (Eq. 5) */
+  real *gC;               /* concentration gradient (Eq. 29), 2 */
+  real *uch;              /* U_char (after Eq. 27) */
+  real *lam;              /* smallest eigenvalue of sym(L^-1) */
+  real *nrm;              /* free-surface normal, 2 */
+  real *nt, *sig;         /* shifting projection normal and weight (Eq. 26), 2 and 1 */
+  real *du;               /* shifting velocity (Eq. 27), 2 */
   real *drho, *acc, *vel; /* time derivatives: d rho/dt, du/dt (2), dx/dt (2) */
-  uint8_t *fs;       /* 1: free-surface particle (set F) */
-  uint8_t *reg;      /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
+  uint8_t *fs;            /* 1: free-surface particle (set F) */
+  uint8_t *reg;           /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
 } rhod_sph;
 
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p);
