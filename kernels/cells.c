@@ -1,6 +1,7 @@
 /* Cell lists: key, histogram, scan, scatter, per-cell order by index. Runs where the
  * particles live (device or host). */
 #include "rhod/cells.h"
+#include "rhod/device.h"
 #include "rhod/scene.h"
 #include <math.h>
 #include <stdlib.h>
@@ -13,27 +14,11 @@ static size_t scan_blocks_cap;
 
 static int32_t *blocks_buffer(size_t nb) {
   if (nb > scan_blocks_cap) {
-    if (scan_blocks) {
-#ifdef RHOD_OFFLOAD
-      int32_t *b = scan_blocks;
-      size_t c = scan_blocks_cap;
-#pragma omp target exit data map(delete : b [0:c])
-      (void)b; /* GCC 12 flags map-only variables as unused */
-#endif
-      free(scan_blocks);
-    }
+    rhod_dev_free(scan_blocks, scan_blocks_cap * sizeof(int32_t));
     scan_blocks_cap = nb + 64;
-    scan_blocks = calloc(scan_blocks_cap, sizeof(int32_t));
-    if (!scan_blocks) {
+    scan_blocks = rhod_dev_calloc(scan_blocks_cap, sizeof(int32_t));
+    if (!scan_blocks)
       scan_blocks_cap = 0;
-      return NULL;
-    }
-#ifdef RHOD_OFFLOAD
-    int32_t *b = scan_blocks;
-    size_t c = scan_blocks_cap;
-#pragma omp target enter data map(alloc : b [0:c])
-    (void)b; /* GCC 12 flags map-only variables as unused */
-#endif
   }
   return scan_blocks;
 }
@@ -83,28 +68,10 @@ long rhod_scan_exclusive(int32_t *a, size_t n) {
   return total;
 }
 
-static void map_alloc(int32_t **p, size_t n) {
-  *p = calloc(n ? n : 1, sizeof(int32_t));
-#ifdef RHOD_OFFLOAD
-  int32_t *q = *p;
-  if (q) {
-#pragma omp target enter data map(to : q [0:n])
-    (void)q; /* GCC 12 flags map-only variables as unused */
-  }
-#endif
-}
+static void map_alloc(int32_t **p, size_t n) { *p = rhod_dev_calloc(n, sizeof(int32_t)); }
 
 static void map_free(int32_t **p, size_t n) {
-  if (!*p)
-    return;
-#ifdef RHOD_OFFLOAD
-  int32_t *q = *p;
-#pragma omp target exit data map(delete : q [0:n])
-  (void)q; /* GCC 12 flags map-only variables as unused */
-#else
-  (void)n;
-#endif
-  free(*p);
+  rhod_dev_free(*p, n * sizeof(int32_t));
   *p = NULL;
 }
 

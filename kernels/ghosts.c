@@ -104,26 +104,10 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
 static int ensure_count(rhod_boundary *b, size_t need) {
   if (need <= b->count_cap && b->count)
     return RHOD_OK;
-  if (b->count) {
-#ifdef RHOD_OFFLOAD
-    int32_t *c = b->count;
-    size_t cc = b->count_cap;
-#pragma omp target exit data map(delete : c [0:cc])
-    (void)c; /* GCC 12 flags map-only variables as unused */
-#endif
-    free(b->count);
-  }
+  rhod_dev_free(b->count, b->count_cap * sizeof(int32_t));
   b->count_cap = need + need / 4 + 64;
-  b->count = calloc(b->count_cap, sizeof(int32_t));
-  if (!b->count)
-    return RHOD_ERR_MEMORY;
-#ifdef RHOD_OFFLOAD
-  int32_t *c = b->count;
-  size_t cc = b->count_cap;
-#pragma omp target enter data map(alloc : c [0:cc])
-  (void)c; /* GCC 12 flags map-only variables as unused */
-#endif
-  return RHOD_OK;
+  b->count = rhod_dev_calloc(b->count_cap, sizeof(int32_t));
+  return b->count ? RHOD_OK : RHOD_ERR_MEMORY;
 }
 
 /* Phase 1: wall mirrors of the fluid. Returns the number of ghosts written or < 0. */

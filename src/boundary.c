@@ -55,32 +55,6 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
   return RHOD_OK;
 }
 
-static void to_device(void *ptr, size_t bytes) {
-#ifdef RHOD_OFFLOAD
-  char *c = ptr;
-  if (c && bytes) {
-#pragma omp target enter data map(to : c [0:bytes])
-    (void)c; /* GCC 12 flags map-only variables as unused */
-  }
-#else
-  (void)ptr;
-  (void)bytes;
-#endif
-}
-
-static void off_device(void *ptr, size_t bytes) {
-#ifdef RHOD_OFFLOAD
-  char *c = ptr;
-  if (c && bytes) {
-#pragma omp target exit data map(delete : c [0:bytes])
-    (void)c; /* GCC 12 flags map-only variables as unused */
-  }
-#else
-  (void)ptr;
-  (void)bytes;
-#endif
-}
-
 int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2],
                        const double hi[2]) {
   memset(b, 0, sizeof *b);
@@ -118,21 +92,20 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
     if (st != RHOD_OK)
       return st;
   }
-  to_device(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
-  to_device(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
-  to_device(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
+  rhod_dev_map(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
+  rhod_dev_map(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
+  rhod_dev_map(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
   return RHOD_OK;
 }
 
 void rhod_boundary_free(rhod_boundary *b) {
-  off_device(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
-  off_device(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
-  off_device(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
-  off_device(b->count, sizeof(int32_t) * b->count_cap);
+  rhod_dev_unmap(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
+  rhod_dev_unmap(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
+  rhod_dev_unmap(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
   free(b->seg);
   free(b->corner);
   free(b->circ);
-  free(b->count);
+  rhod_dev_free(b->count, sizeof(int32_t) * b->count_cap);
   memset(b, 0, sizeof *b);
 }
 

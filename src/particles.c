@@ -1,87 +1,15 @@
 /* Particle store: allocation, device mapping, growth and reordering. */
 #include "rhod/particles.h"
+#include "rhod/device.h"
 #include "rhod/scene.h"
-#include <omp.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static void dev_alloc(void *ptr, size_t bytes) {
-#ifdef RHOD_OFFLOAD
-  char *c = ptr;
-#pragma omp target enter data map(alloc : c [0:bytes])
-  (void)c; /* GCC 12 flags map-only variables as unused */
-#else
-  (void)ptr;
-  (void)bytes;
-#endif
-}
-
-static void dev_free(void *ptr, size_t bytes) {
-#ifdef RHOD_OFFLOAD
-  char *c = ptr;
-#pragma omp target exit data map(delete : c [0:bytes])
-  (void)c; /* GCC 12 flags map-only variables as unused */
-#else
-  (void)ptr;
-  (void)bytes;
-#endif
-}
-
-void rhod_to_host(void *ptr, size_t bytes) {
-#ifdef RHOD_OFFLOAD
-  char *c = ptr;
-  if (bytes) {
-#pragma omp target update from(c [0:bytes])
-    (void)c;
-  }
-#else
-  (void)ptr;
-  (void)bytes;
-#endif
-}
-
-void rhod_to_device(void *ptr, size_t bytes) {
-#ifdef RHOD_OFFLOAD
-  char *c = ptr;
-  if (bytes) {
-#pragma omp target update to(c [0:bytes])
-    (void)c;
-  }
-#else
-  (void)ptr;
-  (void)bytes;
-#endif
-}
-
-int rhod_where(char *buf, size_t len) {
-  int ndev = omp_get_num_devices();
-  int initial = 1;
-#ifdef RHOD_OFFLOAD
-#pragma omp target map(from : initial)
-  { initial = omp_is_initial_device(); }
-#endif
-  if (initial)
-    snprintf(buf, len, "host, %d OpenMP threads (%s build, %d offload devices)",
-             omp_get_max_threads(),
-#ifdef RHOD_OFFLOAD
-             "offload",
-#else
-             "host-only",
-#endif
-             ndev);
-  else
-    snprintf(buf, len, "GPU, OpenMP device %d of %d (nvptx offload)", omp_get_default_device(),
-             ndev);
-  return !initial;
-}
-
 static int alloc_field(rhod_field_desc *f, size_t cap) {
-  void *a = calloc(cap ? cap : 1, f->elem);
+  void *a = rhod_dev_calloc(cap, f->elem);
   if (!a)
     return RHOD_ERR_MEMORY;
   *f->ptr = a;
-  dev_alloc(a, cap * f->elem);
   return RHOD_OK;
 }
 
@@ -96,18 +24,12 @@ static size_t scratch_elem(const rhod_particles *p) {
 
 static int alloc_scratch(rhod_particles *p) {
   p->scratch_elem = scratch_elem(p);
-  p->scratch = calloc(p->cap ? p->cap : 1, p->scratch_elem);
-  if (!p->scratch)
-    return RHOD_ERR_MEMORY;
-  dev_alloc(p->scratch, p->cap * p->scratch_elem);
-  return RHOD_OK;
+  p->scratch = rhod_dev_calloc(p->cap, p->scratch_elem);
+  return p->scratch ? RHOD_OK : RHOD_ERR_MEMORY;
 }
 
 static void free_scratch(rhod_particles *p) {
-  if (!p->scratch)
-    return;
-  dev_free(p->scratch, p->cap * p->scratch_elem);
-  free(p->scratch);
+  rhod_dev_free(p->scratch, p->cap * p->scratch_elem);
   p->scratch = NULL;
 }
 
@@ -164,7 +86,7 @@ int rhod_particles_reserve(rhod_particles *p, size_t cap) {
   for (int i = 0; i < p->nfields; i++) {
     rhod_field_desc *f = &p->fields[i];
     void *old = *f->ptr;
-    void *a = calloc(newcap, f->elem);
+    void *a = rhod_dev_calloc(newcap, f->elem);
     if (!a)
       return RHOD_ERR_MEMORY;
     if (f->persistent) {
@@ -172,10 +94,8 @@ int rhod_particles_reserve(rhod_particles *p, size_t cap) {
       rhod_to_host(old, p->n * f->elem);
       memcpy(a, old, p->n * f->elem);
     }
-    dev_free(old, p->cap * f->elem);
-    free(old);
+    rhod_dev_free(old, p->cap * f->elem);
     *f->ptr = a;
-    dev_alloc(a, newcap * f->elem);
     if (f->persistent)
       rhod_to_device(a, p->n * f->elem);
   }
@@ -187,11 +107,8 @@ int rhod_particles_reserve(rhod_particles *p, size_t cap) {
 void rhod_particles_free(rhod_particles *p) {
   for (int i = 0; i < p->nfields; i++) {
     rhod_field_desc *f = &p->fields[i];
-    if (*f->ptr) {
-      dev_free(*f->ptr, p->cap * f->elem);
-      free(*f->ptr);
-      *f->ptr = NULL;
-    }
+    rhod_dev_free(*f->ptr, p->cap * f->elem);
+    *f->ptr = NULL;
   }
   free_scratch(p);
   memset(p, 0, sizeof *p);

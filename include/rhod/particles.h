@@ -9,6 +9,7 @@
 #define RHOD_PARTICLES_H
 
 #include "rhod/config.h"
+#include "rhod/device.h"
 #include <stdint.h>
 
 #define RHOD_MAX_FIELDS 96
@@ -52,11 +53,4 @@ void rhod_particles_free(rhod_particles *p);
 /* Reorders the persistent arrays of the fluid: new[k] = old[perm[k]], k < n.
  * perm lives on the device (p->perm). */
 void rhod_particles_permute(rhod_particles *p);
-/* Copies fields between host and device (no-ops without offload). count = particles. */
-void rhod_to_host(void *ptr, size_t bytes);
-void rhod_to_device(void *ptr, size_t bytes);
-/* Where the kernels run: fills `buf` with e.g. "host (2 threads)" or
- * "GPU device 0 of 1 (offload)"; returns 1 when on a device. */
-int rhod_where(char *buf, size_t len);
-
 #endif
