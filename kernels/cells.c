@@ -75,9 +75,12 @@ static void map_free(int32_t **p, size_t n) {
   *p = NULL;
 }
 
-int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double cell,
+int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double radius, int reach,
                     size_t cap) {
   memset(c, 0, sizeof *c);
+  if (reach < 1)
+    return RHOD_ERR_SCENE;
+  const double cell = radius / reach;
   if (!(cell > 0))
     return RHOD_ERR_SCENE;
   const double w = hi[0] - lo[0], h = hi[1] - lo[1];
@@ -94,10 +97,12 @@ int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], doubl
   c->g.ox = (real)lo[0];
   c->g.oy = (real)lo[1];
   c->g.inv = (real)(1.0 / cw);
+  c->g.reach = reach;
   c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   map_alloc(&c->start, c->ncells + 1);
   map_alloc(&c->count, c->ncells + 1);
-  if (!c->start || !c->count)
+  c->mark = rhod_dev_calloc(c->ncells, 1);
+  if (!c->start || !c->count || !c->mark)
     return RHOD_ERR_MEMORY;
   return rhod_cells_reserve(c, cap);
 }
@@ -116,6 +121,8 @@ int rhod_cells_reserve(rhod_cells *c, size_t cap) {
 void rhod_cells_free(rhod_cells *c) {
   map_free(&c->start, c->ncells + 1);
   map_free(&c->count, c->ncells + 1);
+  rhod_dev_free(c->mark, c->ncells);
+  c->mark = NULL;
   map_free(&c->idx, c->cap);
   map_free(&c->key, c->cap);
 }
@@ -168,5 +175,18 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
       }
       idx[t + 1] = v;
     }
+  }
+}
+
+void rhod_cells_mark(rhod_cells *c, const uint8_t *flag) {
+  const int32_t *start = c->start, *idx = c->idx;
+  uint8_t *mark = c->mark;
+  const long nc = (long)c->ncells;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nc; k++) {
+    uint8_t m = 0;
+    for (int s = start[k]; s < start[k + 1] && !m; s++)
+      m = flag[idx[s]] != 0;
+    mark[k] = m;
   }
 }

@@ -90,7 +90,7 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
 
 /* Pass A: Gamma, grad Gamma, B = L^-1, raw gradients of P and u, div u, grad C,
  * U_char; then L, the renormalised gradients (Eq. 14) and lambda, per particle. */
-static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const long n = (long)p->n;
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
@@ -104,7 +104,9 @@ static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
     const real uxi = ux[i], uyi = uy[i], Pi = P[i], dxi = dx[i];
-    real g = rhod_W(kern, 0, Ri) * V[i]; /* self term of Eq. 7 */
+    const real iR = 1 / Ri, iR2 = iR * iR, iR3 = iR2 * iR;
+    real g = rhod_Wq(kern, 0) * iR2 * V[i];        /* self term of Eq. 7 */
+    const real iWdx = 1 / rhod_Wq(kern, dxi * iR); /* R^-2/W(dx_ij) of Eq. 29, dx_j = dx_i */
     real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
     real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0, um = 0;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
@@ -113,8 +115,9 @@ static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
         const real r = sqrt(r2), ir = 1 / r;
         const real nx = rx * ir, ny = ry * ir;
         const real Vj = V[j];
-        const real F = -rhod_dW(kern, r, Ri) * Vj; /* |grad_i W_ij| V_j */
-        const real Wv = rhod_W(kern, r, Ri) * Vj;
+        const real q = r * iR;
+        const real F = -rhod_dWq(kern, q) * iR3 * Vj; /* |grad_i W_ij| V_j */
+        const real Wq = rhod_Wq(kern, q), Wv = Wq * iR2 * Vj;
         const real gwx = F * nx, gwy = F * ny;
         g += Wv;                        /* Eq. 7 */
         ggx += gwx, ggy += gwy;         /* Eq. 27 */
@@ -126,7 +129,8 @@ static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
         Gu2 += duy * gwx, Gu3 += duy * gwy;
         div += dux * gwx + duy * gwy; /* Eq. 5 */
         /* Eq. 29: [1 + 0.2 (W_ij / W(dx_ij))^4] grad_i W_ij V_j, W(dx_ij) with R_i */
-        const real wr = rhod_W(kern, r, Ri) / rhod_W(kern, (real)0.5 * (dxi + dx[j]), Ri);
+        const real dxj = dx[j];
+        const real wr = dxj == dxi ? Wq * iWdx : Wq / rhod_Wq(kern, (real)0.5 * (dxi + dxj) * iR);
         const real f = 1 + (real)0.2 * wr * wr * wr * wr;
         cx += f * gwx, cy += f * gwy;
         const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
@@ -163,7 +167,7 @@ static void pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
 
 /* Ghost copies of the pass A gradients: grad P' = J grad P + rho (I - J) g for the
  * hydrostatic-corrected ghost pressure, grad u' = T (grad u) J^T, div u' = tr grad u'. */
-static void mirror_gradients(rhod_sph *s, rhod_particles *p) {
+void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   const int32_t *gsrc = p->gsrc;
   const real *gJ = p->gJ, *gT = p->gT, *rho = p->rho;
@@ -196,7 +200,7 @@ static void mirror_gradients(rhod_sph *s, rhod_particles *p) {
 
 /* Free-surface detection of Marrone et al. 2010 (paper 002 Ref. 51; scheme.md step 3):
  * lambda <= lam_lo: surface; > lam_hi: not; between: the scan-region test. */
-static void pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const long n = (long)p->n;
   uint8_t *fs = s->fs;
   real *nrm = s->nrm;
@@ -257,7 +261,7 @@ static void pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *
 }
 
 /* Ghosts take the flags and normals of their sources (normal mirrored with J). */
-static void mirror_surface(rhod_sph *s, rhod_particles *p) {
+void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   const int32_t *gsrc = p->gsrc;
   const real *gJ = p->gJ;
@@ -279,7 +283,7 @@ static void mirror_surface(rhod_sph *s, rhod_particles *p) {
  * normals of the free-surface particles in the support (i itself included when in F),
  * normalised; sigma_i = 1 on F and 1 - d_i/R_i on V, d_i the distance to the nearest
  * free-surface particle, so the projection fades out continuously across V. */
-static void pass_region(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   const long n = (long)p->n;
   uint8_t *reg = s->reg;
   real *nt = s->nt, *sig = s->sig;
@@ -293,13 +297,22 @@ static void pass_region(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     }
     return;
   }
+  /* most particles have no free-surface particle in reach: a per-cell flag lets
+   * them skip the gather */
+  rhod_cells_mark(c, fs);
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
+  const uint8_t *mark = c->mark;
   const int kern = s->kernel;
   const real ratio = s->ratio;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
+    if (!rhod_cells_near_mark(G, mark, xi, yi)) {
+      reg[i] = 0, sig[i] = 0;
+      nt[2 * i] = 0, nt[2 * i + 1] = 0;
+      continue;
+    }
     real sx = 0, sy = 0, dmin2 = R2;
     int any = 0;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
@@ -327,7 +340,7 @@ static void pass_region(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
 }
 
 /* Shifting velocity, Eqs. 25-27 (no gather: grad C and U_char come from pass A). */
-static void pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
+void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
   const long n = (long)p->n, nt_ = (long)(p->n + p->ng);
   real *du = s->du;
   if (!s->shifting) {
@@ -371,7 +384,7 @@ static void pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
 }
 
 /* Pass C: the right-hand side of Eq. 3. */
-static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const long n = (long)p->n;
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
@@ -383,20 +396,30 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const int kern = s->kernel, riemann = s->riemann, recon = s->recon, damper = s->damper,
             shifting = s->shifting;
   const real ratio = s->ratio, c0 = s->c0, rho0 = s->rho0, ic2 = 1 / (s->c0 * s->c0);
-  const real mu = s->mu, alpha_mu = s->mu != 0 ? 1 : 0, gx = s->gx, gy = s->gy;
-  const real alpha_ad = s->alpha_ad, gth = s->gamma_th, tth = s->theta_th;
-  const real visc_k = 2 * (RHOD_DIM + 2) * mu; /* Eq. 10 */
+  const real alpha_mu = s->mu != 0 ? 1 : 0, gx = s->gx, gy = s->gy;
+  const real alpha_ad = damper ? s->alpha_ad : 0, gth = s->gamma_th, tth = s->theta_th;
+  const real visc_k = 2 * (RHOD_DIM + 2) * s->mu; /* Eq. 10 */
+  /* Theta^u only without viscosity: the alpha_mu exclusion of Eq. 3 */
+  const int theta_u = riemann && alpha_mu == 0;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], dxi = dx[i], Ri = ratio * dxi, R2 = Ri * Ri;
+    const real iR = 1 / Ri, iR3 = iR * iR * iR;
     const real uxi = ux[i], uyi = uy[i], rhoi = rho[i], Pi = P[i], Di = D[i];
     const real dui = du[2 * i], dvi = du[2 * i + 1];
     const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];
     const real *Gi = gu + 4 * i;
-    real pmx = 0, pmy = 0, ppx = 0, ppy = 0;    /* sums of Eq. 6, both forms */
-    real thx = 0, thy = 0;                      /* sum theta_ij grad W V, Eq. 24 */
+    /* Which sums are renormalised is known before the loop (Eq. 6: i in I and
+     * Gamma_i >= 0.85; Eq. 24: i in I and Gamma_i > 0.95), so the pressure, Theta^u
+     * and damper sums share two vector accumulators: vR (multiplied by L^T after the
+     * loop) and vC (used as is); sf = sum grad_i W_ij V_j carries the P_i and D_i
+     * parts. */
+    const int inner = reg[i] == 0;
+    const real renP = (inner && gam[i] >= gth) ? 1 : 0;
+    const real renT = (inner && gam[i] > tth) ? 1 : 0;
+    const real kAD = alpha_ad * rho0 * c0 * (real)0.5 * Ri; /* Eq. 9, h_i = R_i/2 */
+    real vRx = 0, vRy = 0, vCx = 0, vCy = 0, sfx = 0, sfy = 0;
     real cont = 0;                              /* continuity, Eq. 22 */
-    real adx = 0, ady = 0;                      /* Eq. 9 */
     real vsx = 0, vsy = 0;                      /* Eq. 10 */
     real ddu = 0, drdu = 0, ruux = 0, ruuy = 0; /* Eq. 4 */
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
@@ -404,14 +427,16 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       if (r2 < R2 && j != i) {
         const real r = sqrt(r2), ir = 1 / r;
         const real nx = rx * ir, ny = ry * ir;
-        const real F = -rhod_dW(kern, r, Ri) * V[j]; /* |grad_i W_ij| V_j */
+        const real F = -rhod_dWq(kern, r * iR) * iR3 * V[j]; /* |grad_i W_ij| V_j */
+        const real fx = F * nx, fy = F * ny;
         const real Pj = P[j];
-        pmx += (Pj - Pi) * F * nx, pmy += (Pj - Pi) * F * ny;
-        ppx += (Pj + Pi) * F * nx, ppy += (Pj + Pi) * F * ny;
+        real aR = renP * Pj, aC = (1 - renP) * Pj - kAD * D[j];
+        sfx += fx, sfy += fy;
         const real uni = uxi * nx + uyi * ny, unj = ux[j] * nx + uy[j] * ny;
-        /* weights of Eq. 12: w_i = dx_i / (dx_i + dx_j) */
-        const real wi = dxi / (dxi + dx[j]), wj = 1 - wi;
         if (riemann) {
+          /* weights of Eq. 12: w_i = dx_i / (dx_i + dx_j) (1/2 at equal sizes) */
+          const real dxj = dx[j];
+          const real wi = dxj == dxi ? (real)0.5 : dxi / (dxi + dxj), wj = 1 - wi;
           /* states of Eqs. 13-16 for P and the normal velocity u.n_ij */
           const real *Gj = gu + 4 * j;
           const real gPi_n = gPix * nx + gPiy * ny;
@@ -425,17 +450,21 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
           /* Eq. 22: -rho_i <div u> + Theta^rho = -2 rho_i sum (u_E + R_ij).n F V,
            * R_ij = -(3/2 - w_i) u_i - (1/2 - w_j) u_j */
           cont += (uE - ((real)1.5 - wi) * uni - ((real)0.5 - wj) * unj) * F;
-          /* Eq. 24: theta_ij = 2 (P_E - [(1 - w_i) P_i + (1 - w_j) P_j]) */
-          const real th = 2 * (PE - ((1 - wi) * Pi + (1 - wj) * Pj));
-          thx += th * F * nx, thy += th * F * ny;
+          if (theta_u) {
+            /* Eq. 24: theta_ij = 2 (P_E - [(1 - w_i) P_i + (1 - w_j) P_j]) */
+            const real th = 2 * (PE - ((1 - wi) * Pi + (1 - wj) * Pj));
+            aR += renT * th;
+            aC += (1 - renT) * th;
+          }
+        } else {
+          cont += (unj - uni) * F; /* Eq. 5 */
         }
-        if (damper) {
-          adx += (D[j] + Di) * F * nx, ady += (D[j] + Di) * F * ny;
-        }
+        vRx += aR * fx, vRy += aR * fy;
+        vCx += aC * fx, vCy += aC * fy;
         if (visc_k != 0) {
           /* pi_ij of Eq. 10 */
           const real pij = ((ux[j] - uxi) * rx + (uy[j] - uyi) * ry) / r2;
-          vsx += pij * F * nx, vsy += pij * F * ny;
+          vsx += pij * fx, vsy += pij * fy;
         }
         if (shifting) {
           const real duj = du[2 * j], dvj = du[2 * j + 1], rhoj = rho[j];
@@ -449,35 +478,15 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     }
     RHOD_END_NEIGHBOURS
     const real *Li = L + 4 * i;
-    const int inner = reg[i] == 0;
-    /* Eq. 6: renormalised in the bulk, conservative near the surface */
-    real gpx, gpy;
-    if (inner && gam[i] >= gth) {
-      gpx = Li[0] * pmx + Li[2] * pmy;
-      gpy = Li[1] * pmx + Li[3] * pmy;
-    } else {
-      gpx = ppx, gpy = ppy;
-    }
-    real fx = -gpx + rhoi * gx, fy = -gpy + rhoi * gy;
-    real dr;
-    if (riemann) {
-      dr = -2 * rhoi * cont;
-      /* Eq. 24 and the alpha_mu exclusion of Eq. 3 */
-      if (alpha_mu == 0) {
-        if (inner && gam[i] > tth) {
-          fx -= Li[0] * thx + Li[2] * thy;
-          fy -= Li[1] * thx + Li[3] * thy;
-        } else {
-          fx -= thx, fy -= thy;
-        }
-      }
-    } else {
-      dr = -rhoi * Di;
-    }
-    if (damper) { /* Eq. 9, h_i = R_i / 2 */
-      const real k = alpha_ad * rho0 * c0 * (real)0.5 * Ri;
-      fx += k * adx, fy += k * ady;
-    }
+    /* renormalised part: L^T (vR - renP P_i sf) */
+    const real wx = vRx - renP * Pi * sfx, wy = vRy - renP * Pi * sfy;
+    /* plain part: vC + ((1 - renP) P_i - kAD D_i) sf, i.e. sum (P_j + P_i) gW V for a
+     * conservative Eq. 6, and -F^AD of Eq. 9 */
+    const real ki = (1 - renP) * Pi - kAD * Di;
+    real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * gx;
+    real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * gy;
+    /* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
+    real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
     if (visc_k != 0)
       fx += alpha_mu * visc_k * vsx, fy += alpha_mu * visc_k * vsy;
     if (shifting) { /* Eq. 4 */
@@ -490,14 +499,14 @@ static void pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   }
 }
 
-void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, const rhod_cells *c, real dt) {
-  pass_a(s, p, c);
-  mirror_gradients(s, p);
-  pass_free_surface(s, p, c);
-  mirror_surface(s, p);
-  pass_region(s, p, c);
-  pass_shift(s, p, dt);
-  pass_c(s, p, c);
+void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt) {
+  rhod_sph_pass_a(s, p, c);
+  rhod_sph_mirror_gradients(s, p);
+  rhod_sph_pass_free_surface(s, p, c);
+  rhod_sph_mirror_surface(s, p);
+  rhod_sph_pass_region(s, p, c);
+  rhod_sph_pass_shift(s, p, dt);
+  rhod_sph_pass_c(s, p, c);
 }
 
 real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {

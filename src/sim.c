@@ -187,7 +187,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
       rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
   const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
   const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
-  st = rhod_cells_init(&s->cells, glo, ghi, s->margin, p->cap);
+  st = rhod_cells_init(&s->cells, glo, ghi, s->margin, RHOD_CELL_REACH, p->cap);
   if (st != RHOD_OK) {
     snprintf(err, errlen, "%s: domain: too many cells for particles.dx = %g", sc->path, sc->dx);
     return st;

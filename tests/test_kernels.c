@@ -75,7 +75,8 @@ typedef struct {
   rhod_scene *sc;
 } cloud;
 
-static void cloud_make(cloud *cl, int nx, int ny, double dx, double jitter, unsigned long seed) {
+static void cloud_make_reach(cloud *cl, int nx, int ny, double dx, double jitter,
+                             unsigned long seed, int reach) {
   cl->sc = unit_scene(dx);
   rhod_particles_init(&cl->p, (size_t)(nx * ny) + 16);
   rhod_particles *p = &cl->p;
@@ -94,7 +95,11 @@ static void cloud_make(cloud *cl, int nx, int ny, double dx, double jitter, unsi
   p->n = n;
   rhod_sph_init(&cl->s, cl->sc, p);
   const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
-  rhod_cells_init(&cl->c, lo, hi, 4 * dx, p->cap);
+  rhod_cells_init(&cl->c, lo, hi, 4 * dx, reach, p->cap);
+}
+
+static void cloud_make(cloud *cl, int nx, int ny, double dx, double jitter, unsigned long seed) {
+  cloud_make_reach(cl, nx, ny, dx, jitter, seed, RHOD_CELL_REACH);
 }
 
 static void cloud_sync(cloud *cl) {
@@ -111,36 +116,38 @@ static void cloud_free(cloud *cl) {
 }
 
 static void test_neighbours_brute_force(void) {
-  cloud cl;
-  cloud_make(&cl, 37, 23, 0.01, 0.9, 7);
-  cloud_sync(&cl);
-  rhod_particles *p = &cl.p;
-  rhod_cells_build(&cl.c, p->x, p->y, p->n);
-  rhod_to_host(cl.c.start, (cl.c.ncells + 1) * sizeof(int32_t));
-  rhod_to_host(cl.c.idx, p->n * sizeof(int32_t));
-  const rhod_grid G = cl.c.g;
-  const int32_t *CS = cl.c.start, *CI = cl.c.idx;
-  const real R = (real)0.04;
-  long mism = 0, total = 0;
-  for (size_t i = 0; i < p->n; i++) {
-    int found = 0, brute = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, p->x[i], p->y[i], j) {
-      const real rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i];
-      if (rx * rx + ry * ry < R * R)
-        found++;
+  for (int reach = 1; reach <= 3; reach++) {
+    cloud cl;
+    cloud_make_reach(&cl, 37, 23, 0.01, 0.9, 7, reach);
+    cloud_sync(&cl);
+    rhod_particles *p = &cl.p;
+    rhod_cells_build(&cl.c, p->x, p->y, p->n);
+    rhod_to_host(cl.c.start, (cl.c.ncells + 1) * sizeof(int32_t));
+    rhod_to_host(cl.c.idx, p->n * sizeof(int32_t));
+    const rhod_grid G = cl.c.g;
+    const int32_t *CS = cl.c.start, *CI = cl.c.idx;
+    const real R = (real)0.04;
+    long mism = 0, total = 0;
+    for (size_t i = 0; i < p->n; i++) {
+      int found = 0, brute = 0;
+      RHOD_FOR_NEIGHBOURS(G, CS, CI, p->x[i], p->y[i], j) {
+        const real rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i];
+        if (rx * rx + ry * ry < R * R)
+          found++;
+      }
+      RHOD_END_NEIGHBOURS
+      for (size_t j = 0; j < p->n; j++) {
+        const real rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i];
+        if (rx * rx + ry * ry < R * R)
+          brute++;
+      }
+      mism += found != brute;
+      total += brute;
     }
-    RHOD_END_NEIGHBOURS
-    for (size_t j = 0; j < p->n; j++) {
-      const real rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i];
-      if (rx * rx + ry * ry < R * R)
-        brute++;
-    }
-    mism += found != brute;
-    total += brute;
+    CU_ASSERT_EQUAL(mism, 0);
+    CU_ASSERT(total > 30 * (long)p->n); /* about 50 neighbours each, fewer at the edges */
+    cloud_free(&cl);
   }
-  CU_ASSERT_EQUAL(mism, 0);
-  CU_ASSERT(total > 30 * (long)p->n); /* about 50 neighbours each, fewer at the edges */
-  cloud_free(&cl);
 }
 
 static void test_sort_determinism(void) {

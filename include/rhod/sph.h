@@ -38,11 +38,21 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p);
 
 /* One right-hand-side evaluation at the current positions: the neighbour structure
  * must be built (ghosts generated, cells sorted). Fills drho, acc, vel for the fluid. */
-void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, const rhod_cells *c, real dt);
+void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt);
 
 /* Values of the ghosts from their sources (state part: u, P, rho, V), and the fluid
  * EOS. Called after the ghosts are built and before any gather. */
 void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p);
+
+/* The passes of one right-hand side, in the order rhod_sph_rhs runs them (public for
+ * the per-pass benchmarks): */
+void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
+void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p);
+void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
+void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p);
+void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c);
+void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt);
+void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 
 /* Time step of Eq. 11 over the fluid. */
 real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p);

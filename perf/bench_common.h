@@ -1,0 +1,82 @@
+/* Shared set-up of the benchmarks: a perturbed lattice of about N particles with a
+ * Taylor-Green velocity field, either in a doubly periodic unit box ("box", no free
+ * surface) or as a free square patch in empty space ("patch", a free surface all
+ * round). Every RHOD-SPH term on. */
+#ifndef RHOD_BENCH_COMMON_H
+#define RHOD_BENCH_COMMON_H
+
+#include "rhod/sim.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static inline double bench_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+typedef struct {
+  rhod_scene sc;
+  rhod_fluid_block fb;
+} bench_scene;
+
+static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch) {
+  const int side = (int)ceil(sqrt(N));
+  const double L = 1.0, dx = L / side;
+  rhod_scene *sc = &b->sc;
+  memset(b, 0, sizeof *b);
+  sc->t_end = 1, sc->output_every = 1, sc->cfl = 0.5, sc->cfl_visc = 0.025;
+  sc->dx = dx, sc->radius_ratio = 4, sc->kernel = RHOD_KERNEL_WENDLAND_C2;
+  sc->rho0 = 1000, sc->c0 = 10, sc->mu = 0;
+  sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = 1;
+  sc->free_surface = 1;
+  sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
+  sc->fs_lambda_low = 0.2, sc->fs_lambda_high = 0.75;
+  sc->shepard_threshold = 0.85, sc->theta_threshold = 0.95;
+  sc->has_domain = 1;
+  sc->domain_min[0] = sc->domain_min[1] = patch ? -0.5 : 0;
+  sc->domain_max[0] = sc->domain_max[1] = patch ? 1.5 : L;
+  sc->periodic[0] = sc->periodic[1] = !patch;
+  b->fb.shape.kind = RHOD_SHAPE_RECT;
+  b->fb.shape.max[0] = L, b->fb.shape.max[1] = L;
+  sc->fluid = &b->fb, sc->n_fluid = 1;
+  sc->path = "bench";
+  char err[512];
+  if (rhod_sim_init(s, sc, err, sizeof err) != RHOD_OK) {
+    fprintf(stderr, "bench: %s\n", err);
+    return 1;
+  }
+  rhod_particles *p = &s->p;
+  rhod_to_host(p->x, p->n * sizeof(real));
+  rhod_to_host(p->y, p->n * sizeof(real));
+  unsigned long r = 12345;
+  for (size_t i = 0; i < p->n; i++) {
+    r = r * 6364136223846793005ul + 1442695040888963407ul;
+    p->x[i] += (real)(0.1 * dx * ((double)(r >> 11) / 9007199254740992.0 - 0.5));
+    r = r * 6364136223846793005ul + 1442695040888963407ul;
+    p->y[i] += (real)(0.1 * dx * ((double)(r >> 11) / 9007199254740992.0 - 0.5));
+    p->ux[i] = (real)(sin(2 * M_PI * p->x[i]) * cos(2 * M_PI * p->y[i]));
+    p->uy[i] = (real)(-cos(2 * M_PI * p->x[i]) * sin(2 * M_PI * p->y[i]));
+  }
+  rhod_to_device(p->x, p->n * sizeof(real));
+  rhod_to_device(p->y, p->n * sizeof(real));
+  rhod_to_device(p->ux, p->n * sizeof(real));
+  rhod_to_device(p->uy, p->n * sizeof(real));
+  return rhod_sim_prepare(s, 1);
+}
+
+static inline size_t bench_bytes(const rhod_particles *p) {
+  size_t bytes = 0;
+  for (int f = 0; f < p->nfields; f++)
+    bytes += p->fields[f].elem;
+  return bytes;
+}
+
+#endif
