@@ -40,12 +40,27 @@ typedef struct {
 } y_circle;
 
 typedef struct {
+  double U, L;
+} y_taylor_green;
+
+typedef struct {
+  double omega;
+  double *center;
+} y_rotation;
+
+typedef struct {
+  y_taylor_green *taylor_green;
+  y_rotation *rotation;
+} y_initial;
+
+typedef struct {
   y_rect *rect;
   y_circle *circle;
   double (*polygon)[2];
   unsigned n_polygon;
   double *velocity;
   int *pressure;
+  y_initial *initial;
 } y_fluid;
 
 typedef struct {
@@ -66,6 +81,7 @@ typedef struct {
   double dx;
   double *radius_ratio;
   int *kernel;
+  double *jitter;
 } y_particles;
 
 typedef struct {
@@ -201,6 +217,7 @@ static const cyaml_schema_field_t f_time[] = {
 static const cyaml_schema_field_t f_particles[] = {
     NUM("dx", y_particles, dx),
     NUM_OPT("radius_ratio", y_particles, radius_ratio),
+    NUM_OPT("jitter", y_particles, jitter),
     ENUM_OPT("kernel", y_particles, kernel, kernel_names),
     CYAML_FIELD_END,
 };
@@ -251,10 +268,30 @@ static const cyaml_schema_field_t f_circle[] = {
       CYAML_FIELD_SEQUENCE_COUNT("polygon", OPT | CYAML_FLAG_FLOW, st, polygon, n_polygon,         \
                                  &sch_vec, 3, CYAML_UNLIMITED)
 
+static const cyaml_schema_field_t f_taylor_green[] = {
+    NUM("U", y_taylor_green, U),
+    NUM("L", y_taylor_green, L),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_rotation[] = {
+    NUM("omega", y_rotation, omega),
+    VEC("center", OPT, y_rotation, center),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_initial[] = {
+    CYAML_FIELD_MAPPING_PTR("taylor_green", OPT | CYAML_FLAG_FLOW, y_initial, taylor_green,
+                            f_taylor_green),
+    CYAML_FIELD_MAPPING_PTR("rotation", OPT | CYAML_FLAG_FLOW, y_initial, rotation, f_rotation),
+    CYAML_FIELD_END,
+};
+
 static const cyaml_schema_field_t f_fluid[] = {
     SHAPE_FIELDS(y_fluid),
     VEC("velocity", OPT, y_fluid, velocity),
     ENUM_OPT("pressure", y_fluid, pressure, init_names),
+    CYAML_FIELD_MAPPING_PTR("initial", OPT, y_fluid, initial, f_initial),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_fluid = {
@@ -1142,6 +1179,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       d->particles.kernel ? (rhod_kernel_kind)*d->particles.kernel : RHOD_KERNEL_WENDLAND_C2;
   TRY(check_positive(c, "particles.dx", s->dx));
   TRY(check_range(c, "particles.radius_ratio", s->radius_ratio, 2, 0, 8, 0));
+  s->jitter = opt(d->particles.jitter, 0);
+  TRY(check_range(c, "particles.jitter", s->jitter, 0, 0, 0.5, 0));
   /* physics */
   s->rho0 = opt(d->physics.rho0, 1000);
   s->c0 = d->physics.c0;
@@ -1219,6 +1258,31 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     b->pressure = y->pressure ? (rhod_init_kind)*y->pressure : RHOD_INIT_HYDROSTATIC;
     double lo[2], hi[2];
     shape_bbox(&b->shape, lo, hi);
+    if (y->initial) {
+      const y_initial *in = y->initial;
+      char ip[192];
+      snprintf(ip, sizeof ip, "%s.initial", path);
+      if (!!in->taylor_green + !!in->rotation != 1)
+        return fail(c, ip, "needs exactly one of taylor_green, rotation");
+      if (in->taylor_green) {
+        snprintf(ip, sizeof ip, "%s.initial.taylor_green.L", path);
+        if (!(in->taylor_green->L > 0))
+          return fail(c, ip, "must be > 0");
+        b->flow = RHOD_FLOW_TAYLOR_GREEN;
+        b->flow_U = in->taylor_green->U;
+        b->flow_L = in->taylor_green->L;
+      } else {
+        if (b->shape.kind != RHOD_SHAPE_RECT)
+          return fail(c, ip, "rotation needs a rect block (its pressure is the series of paper "
+                             "002 Eq. 30 for a rectangle)");
+        b->flow = RHOD_FLOW_ROTATION;
+        b->flow_omega = in->rotation->omega;
+        if (in->rotation->center)
+          memcpy(b->flow_center, in->rotation->center, sizeof b->flow_center);
+        else
+          b->flow_center[0] = 0.5 * (lo[0] + hi[0]), b->flow_center[1] = 0.5 * (lo[1] + hi[1]);
+      }
+    }
     if (s->has_domain && !inside_box(lo, hi, s->domain_min, s->domain_max))
       return fail(c, path,
                   "lies outside the domain [%g, %g]-[%g, %g] (block spans [%g, %g]-[%g, %g])",
@@ -1459,6 +1523,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   m = tb_coll(&t, root, "particles", RY_MAP, 0);
   tb_num(&t, m, "dx", s->dx);
   tb_num(&t, m, "radius_ratio", s->radius_ratio);
+  tb_num(&t, m, "jitter", s->jitter);
   tb_word(&t, m, "kernel",
           strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
   m = tb_coll(&t, root, "physics", RY_MAP, 0);
@@ -1495,6 +1560,19 @@ static ry_node *scene_tree(const rhod_scene *s) {
     tb_vec(&t, e, "velocity", s->fluid[i].velocity);
     tb_word(&t, e, "pressure",
             strval_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
+    const rhod_fluid_block *fb = &s->fluid[i];
+    if (fb->flow != RHOD_FLOW_NONE) {
+      ry_node *in = tb_coll(&t, e, "initial", RY_MAP, 0);
+      if (fb->flow == RHOD_FLOW_TAYLOR_GREEN) {
+        ry_node *k = tb_coll(&t, in, "taylor_green", RY_MAP, 1);
+        tb_num(&t, k, "U", fb->flow_U);
+        tb_num(&t, k, "L", fb->flow_L);
+      } else {
+        ry_node *k = tb_coll(&t, in, "rotation", RY_MAP, 1);
+        tb_num(&t, k, "omega", fb->flow_omega);
+        tb_vec(&t, k, "center", fb->flow_center);
+      }
+    }
   }
   m = tb_coll(&t, root, "walls", RY_SEQ, s->n_walls == 0);
   for (unsigned i = 0; i < s->n_walls; i++) {
@@ -1884,8 +1962,20 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
     fluid_extent(s, e, &lo, &hi);
     H = hi - lo;
   }
-  for (unsigned i = 0; i < s->n_fluid; i++)
-    umax = fmax(umax, hypot(s->fluid[i].velocity[0], s->fluid[i].velocity[1]));
+  for (unsigned i = 0; i < s->n_fluid; i++) {
+    const rhod_fluid_block *b = &s->fluid[i];
+    double flow = 0; /* the initial flow's largest speed */
+    if (b->flow == RHOD_FLOW_TAYLOR_GREEN)
+      flow = fabs(b->flow_U);
+    else if (b->flow == RHOD_FLOW_ROTATION) {
+      double lo[2], hi[2];
+      shape_bbox(&b->shape, lo, hi);
+      const double dx = fmax(fabs(lo[0] - b->flow_center[0]), fabs(hi[0] - b->flow_center[0]));
+      const double dy = fmax(fabs(lo[1] - b->flow_center[1]), fabs(hi[1] - b->flow_center[1]));
+      flow = fabs(b->flow_omega) * hypot(dx, dy);
+    }
+    umax = fmax(umax, hypot(b->velocity[0], b->velocity[1]) + flow);
+  }
   double du = sqrt(2 * g * H) + umax, dp = s->rho0 * g * H;
   double bound = 10 * fmax(du, s->rho0 > 0 ? sqrt(dp / s->rho0) : 0);
   if (s->c0 < bound * (1 - 1e-12))

@@ -7,6 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 static int in_shape(const rhod_shape *sh, double x, double y) {
   if (sh->kind == RHOD_SHAPE_RECT)
     return x >= sh->min[0] && x <= sh->max[0] && y >= sh->min[1] && y <= sh->max[1];
@@ -57,12 +61,45 @@ static double shape_top(const rhod_shape *sh, double ex, double ey) {
   return best;
 }
 
+/* Pressure of a rigid rotation in a rectangle a x b with P = 0 on its sides: the
+ * solution of lap P = 2 rho0 omega^2 as the double sine series of paper 002 Eq. 30
+ * (x, y from the lower-left corner; only odd m, n contribute: the even terms of the
+ * series of a constant vanish). Our choice: terms up to m, n = 199 (the truncation
+ * error is below 1e-5 rho0 omega^2 a b). */
+static double rotation_pressure(double rho0, double omega, double a, double b, double x,
+                                double y) {
+  enum { M = 100 };
+  double sx[M], sy[M];
+  for (int k = 0; k < M; k++) {
+    const int m = 2 * k + 1;
+    sx[k] = sin(m * M_PI * x / a);
+    sy[k] = sin(m * M_PI * y / b);
+  }
+  double p = 0;
+  for (int k = 0; k < M; k++) {
+    const double m = 2 * k + 1, km = m * M_PI / a;
+    for (int l = 0; l < M; l++) {
+      const double n = 2 * l + 1, kn = n * M_PI / b;
+      p += -32 * omega * omega / (m * n * M_PI * M_PI * (km * km + kn * kn)) * sx[k] * sy[l];
+    }
+  }
+  return rho0 * p;
+}
+
+/* Deterministic uniform numbers in [-0.5, 0.5) for the lattice jitter. */
+static double jitter_rand(uint64_t *st) {
+  *st = *st * 6364136223846793005ull + 1442695040888963407ull;
+  return (double)(*st >> 11) / 9007199254740992.0 - 0.5;
+}
+
 static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
   const rhod_scene *sc = s->sc;
   const double dx = sc->dx;
   /* count first, then fill */
   for (int pass = 0; pass < 2; pass++) {
     size_t n = 0;
+    /* the same sequence in both passes: a lattice point keeps its place */
+    uint64_t rs = 0x5eed;
     for (unsigned b = 0; b < sc->n_fluid; b++) {
       const rhod_fluid_block *B = &sc->fluid[b];
       double lo[2], hi[2];
@@ -75,7 +112,12 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
       const double c2 = sc->c0 * sc->c0;
       for (long j = 0; j < ny; j++)
         for (long i = 0; i < nx; i++) {
-          const double x = lo[0] + (i + 0.5) * dx, y = lo[1] + (j + 0.5) * dx;
+          /* particles.jitter breaks the symmetry of the lattice, which otherwise
+           * deforms affinely under a strain field, where Fickian shifting (uniform
+           * concentration) cannot act, until it collapses (seen on the Taylor-Green
+           * vortex) */
+          const double jx = sc->jitter * jitter_rand(&rs), jy = sc->jitter * jitter_rand(&rs);
+          const double x = lo[0] + (i + 0.5 + jx) * dx, y = lo[1] + (j + 0.5 + jy) * dx;
           if (!in_shape(&B->shape, x, y))
             continue;
           int taken = 0; /* a point of an earlier block is not filled twice */
@@ -95,11 +137,25 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
               const double depth = top - (x * ex + y * ey);
               P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
             }
+            double u = B->velocity[0], v = B->velocity[1];
+            if (B->flow == RHOD_FLOW_TAYLOR_GREEN) {
+              const double k = 2 * M_PI / B->flow_L, U = B->flow_U;
+              u += U * sin(k * x) * cos(k * y);
+              v -= U * cos(k * x) * sin(k * y);
+              P += sc->rho0 * U * U / 4 * (cos(2 * k * x) + cos(2 * k * y));
+            } else if (B->flow == RHOD_FLOW_ROTATION) {
+              const double w = B->flow_omega;
+              u -= w * (y - B->flow_center[1]);
+              v += w * (x - B->flow_center[0]);
+              P += rotation_pressure(sc->rho0, w, B->shape.max[0] - B->shape.min[0],
+                                     B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
+                                     y - B->shape.min[1]);
+            }
             const double rho = sc->rho0 + P / c2; /* Eq. 2 */
             p->x[n] = (real)x;
             p->y[n] = (real)y;
-            p->ux[n] = (real)B->velocity[0];
-            p->uy[n] = (real)B->velocity[1];
+            p->ux[n] = (real)u;
+            p->uy[n] = (real)v;
             p->rho[n] = (real)rho;
             p->m[n] = (real)(rho * dx * dx); /* m_i = rho_i(0) V_i(0) */
             p->dx[n] = (real)dx;

@@ -29,9 +29,22 @@ typedef struct {
 
 typedef enum { RHOD_INIT_UNIFORM = 0, RHOD_INIT_HYDROSTATIC } rhod_init_kind;
 
+/* An analytic initial flow added to a block's uniform velocity and pressure. */
+typedef enum {
+  RHOD_FLOW_NONE = 0,
+  RHOD_FLOW_TAYLOR_GREEN, /* u = U sin(kx) cos(ky), v = -U cos(kx) sin(ky), k = 2 pi / L,
+                             P = rho0 U^2/4 (cos 2kx + cos 2ky) */
+  RHOD_FLOW_ROTATION      /* rigid rotation u = omega x (x - center) with the pressure
+                             series of paper 002 Eq. 30 (rect blocks) */
+} rhod_flow_kind;
+
 /* A block of fluid filled with a square lattice of spacing particles.dx. */
 typedef struct {
   rhod_shape shape;
+  rhod_flow_kind flow;    /* initial.taylor_green / initial.rotation */
+  double flow_U, flow_L;  /* taylor_green: amplitude [m/s], period [m] */
+  double flow_omega;      /* rotation: angular velocity [1/s], > 0 counter-clockwise */
+  double flow_center[2];  /* rotation: centre [m], default the block's centre */
   double velocity[2];      /* initial velocity [m/s], default 0 */
   rhod_init_kind pressure; /* uniform (P = 0) or hydrostatic (paper 002 Sec. VI A,
                               free surface at the block's highest point along -g) */
@@ -87,6 +100,8 @@ typedef struct {
   double dx;               /* particles.dx [m] (required) */
   double radius_ratio;     /* particles.radius_ratio = R/dx, default 4 (paper 002 Sec. IV D) */
   rhod_kernel_kind kernel; /* particles.kernel, default wendland_c2 */
+  double jitter;           /* particles.jitter: random shift of the initial lattice points,
+                              a fraction of dx in [0, 0.5], default 0 */
   /* physics: */
   double rho0;       /* physics.rho0 [kg/m^3], default 1000 */
   double c0;         /* physics.c0 [m/s] (required), Eq. 2 */
