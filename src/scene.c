@@ -1273,8 +1273,9 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
         b->flow_L = in->taylor_green->L;
       } else {
         if (b->shape.kind != RHOD_SHAPE_RECT)
-          return fail(c, ip, "rotation needs a rect block (its pressure is the series of paper "
-                             "002 Eq. 30 for a rectangle)");
+          return fail(c, ip,
+                      "rotation needs a rect block (its pressure is the series of paper "
+                      "002 Eq. 30 for a rectangle)");
         b->flow = RHOD_FLOW_ROTATION;
         b->flow_omega = in->rotation->omega;
         if (in->rotation->center)

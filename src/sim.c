@@ -66,8 +66,7 @@ static double shape_top(const rhod_shape *sh, double ex, double ey) {
  * (x, y from the lower-left corner; only odd m, n contribute: the even terms of the
  * series of a constant vanish). Our choice: terms up to m, n = 199 (the truncation
  * error is below 1e-5 rho0 omega^2 a b). */
-static double rotation_pressure(double rho0, double omega, double a, double b, double x,
-                                double y) {
+static double rotation_pressure(double rho0, double omega, double a, double b, double x, double y) {
   enum { M = 100 };
   double sx[M], sy[M];
   for (int k = 0; k < M; k++) {

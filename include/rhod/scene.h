@@ -41,10 +41,10 @@ typedef enum {
 /* A block of fluid filled with a square lattice of spacing particles.dx. */
 typedef struct {
   rhod_shape shape;
-  rhod_flow_kind flow;    /* initial.taylor_green / initial.rotation */
-  double flow_U, flow_L;  /* taylor_green: amplitude [m/s], period [m] */
-  double flow_omega;      /* rotation: angular velocity [1/s], > 0 counter-clockwise */
-  double flow_center[2];  /* rotation: centre [m], default the block's centre */
+  rhod_flow_kind flow;     /* initial.taylor_green / initial.rotation */
+  double flow_U, flow_L;   /* taylor_green: amplitude [m/s], period [m] */
+  double flow_omega;       /* rotation: angular velocity [1/s], > 0 counter-clockwise */
+  double flow_center[2];   /* rotation: centre [m], default the block's centre */
   double velocity[2];      /* initial velocity [m/s], default 0 */
   rhod_init_kind pressure; /* uniform (P = 0) or hydrostatic (paper 002 Sec. VI A,
                               free surface at the block's highest point along -g) */
