@@ -27,7 +27,27 @@ typedef struct {
   rhod_fluid_block fb;
 } bench_scene;
 
-static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch) {
+/* Scheme switches from the command line: any of noshift, nodamper, nofs, noriemann,
+ * norecon, visc (mu such that Re = 100 for the unit box). */
+static inline void bench_switches(rhod_scene *sc, int argc, char **argv, int first) {
+  for (int k = first; k < argc; k++) {
+    if (!strcmp(argv[k], "noshift"))
+      sc->shifting = 0;
+    else if (!strcmp(argv[k], "nodamper"))
+      sc->acoustic_damper = 0;
+    else if (!strcmp(argv[k], "nofs"))
+      sc->free_surface = 0;
+    else if (!strcmp(argv[k], "noriemann"))
+      sc->riemann = 0;
+    else if (!strcmp(argv[k], "norecon"))
+      sc->reconstruction = 0;
+    else if (!strcmp(argv[k], "visc"))
+      sc->mu = 10;
+  }
+}
+
+static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch, int argc,
+                              char **argv, int first) {
   const int side = (int)ceil(sqrt(N));
   const double L = 1.0, dx = L / side;
   rhod_scene *sc = &b->sc;
@@ -48,6 +68,7 @@ static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch) 
   b->fb.shape.max[0] = L, b->fb.shape.max[1] = L;
   sc->fluid = &b->fb, sc->n_fluid = 1;
   sc->path = "bench";
+  bench_switches(sc, argc, argv, first);
   char err[512];
   if (rhod_sim_init(s, sc, err, sizeof err) != RHOD_OK) {
     fprintf(stderr, "bench: %s\n", err);

@@ -1,6 +1,6 @@
 /* Each pass of one RK stage timed alone, repeated: microseconds per particle per call
  * and real neighbour pairs per second for the gathers.
- * usage: bench_passes [N=1e5] [repeats=10] [box|patch] */
+ * usage: bench_passes [N=1e5] [repeats=10] [box|patch] [switches as bench_step] */
 #include "bench_common.h"
 #include "kernel.h"
 
@@ -33,7 +33,7 @@ int main(int argc, char **argv) {
   const int patch = argc > 3 && !strcmp(argv[3], "patch");
   bench_scene b;
   rhod_sim s;
-  if (bench_setup(&b, &s, N, patch) != RHOD_OK)
+  if (bench_setup(&b, &s, N, patch, argc, argv, 4) != RHOD_OK)
     return 1;
   rhod_particles *p = &s.p;
   rhod_sph *h = &s.sph;

@@ -9,7 +9,7 @@ int main(int argc, char **argv) {
   bench_scene b;
   rhod_sim s;
   char err[512];
-  if (bench_setup(&b, &s, N, patch) != RHOD_OK)
+  if (bench_setup(&b, &s, N, patch, argc, argv, 4) != RHOD_OK)
     return 1;
   /* one warm-up step */
   if (rhod_sim_step(&s, s.dt, err, sizeof err) != RHOD_OK) {
