@@ -295,6 +295,16 @@ static void test_pvrs_hand_values(void) {
   rhod_states(0, 3, 3, 3, 1, (real)(1.0 / 3), (real)(2.0 / 3), 1, &L, &Rr);
   CU_ASSERT_DOUBLE_EQUAL(L, 1, 1e-6);
   CU_ASSERT_DOUBLE_EQUAL(Rr, 1, 1e-6);
+  /* states against the limiter of Eq. 15 applied by hand, including opposite signs
+   * and zero slopes: phi_i = 1, phi_j = 2, r = 0.5 (s1 = 2), w_i = 0.25 */
+  const real gs[] = {3, -1, 0, 2, 0.5, -2, 1e-3, 50};
+  for (int a = 0; a < 8; a++)
+    for (int b = 0; b < 8; b++) {
+      real l2, r2;
+      rhod_states(1, 2, gs[a], gs[b], (real)0.5, (real)0.25, (real)0.75, 1, &l2, &r2);
+      CU_ASSERT_DOUBLE_EQUAL(l2, 1 + 0.25 * 0.5 * rhod_limit(2, gs[a]), 1e-5);
+      CU_ASSERT_DOUBLE_EQUAL(r2, 2 - 0.75 * 0.5 * rhod_limit(2, gs[b]), 1e-5);
+    }
 }
 
 /* RK4 on dy/dt = -y, dx/dt = y: error ratio for halved dt near 2^4. */
