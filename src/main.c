@@ -143,7 +143,9 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   char png[4200];
   snprintf(png, sizeof png, "%s/snapshot_%04d.png", c->out, c->nsnap - 1);
   const rhod_scene *sc = c->sc;
-  st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_width, s->lo, s->hi,
+  const double *lo = sc->picture_box_set ? sc->picture_box_min : s->lo;
+  const double *hi = sc->picture_box_set ? sc->picture_box_max : s->hi;
+  st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_width, lo, hi,
                           sc->picture_range_set ? sc->picture_range : NULL, err, len);
   return st;
 }

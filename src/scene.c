@@ -143,6 +143,7 @@ typedef struct {
   int *field;
   double *width;
   double *range;
+  y_rect *box;
 } y_picture;
 
 typedef struct {
@@ -351,6 +352,7 @@ static const cyaml_schema_field_t f_picture[] = {
     ENUM_OPT("field", y_picture, field, field_names),
     NUM_OPT("width", y_picture, width),
     VEC("range", OPT, y_picture, range),
+    CYAML_FIELD_MAPPING_PTR("box", OPT | CYAML_FLAG_FLOW, y_picture, box, f_rect),
     CYAML_FIELD_END,
 };
 
@@ -1377,6 +1379,14 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       return fail(c, "output.picture.range", "low (%g) must be below high (%g)", pic->range[0],
                   pic->range[1]);
   }
+  if (pic && pic->box) {
+    s->picture_box_set = 1;
+    memcpy(s->picture_box_min, pic->box->min, sizeof s->picture_box_min);
+    memcpy(s->picture_box_max, pic->box->max, sizeof s->picture_box_max);
+    if (!(s->picture_box_min[0] < s->picture_box_max[0] &&
+          s->picture_box_min[1] < s->picture_box_max[1]))
+      return fail(c, "output.picture.box.max", "must exceed output.picture.box.min in both axes");
+  }
   /* name */
   if (d->name) {
     if (!valid_name(d->name))
@@ -1605,6 +1615,11 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "width", s->picture_width);
   if (s->picture_range_set)
     tb_vec(&t, m, "range", s->picture_range);
+  if (s->picture_box_set) {
+    ry_node *b = tb_coll(&t, m, "box", RY_MAP, 1);
+    tb_vec(&t, b, "min", s->picture_box_min);
+    tb_vec(&t, b, "max", s->picture_box_max);
+  }
   if (t.oom) {
     ry_free(root);
     return NULL;

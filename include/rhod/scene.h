@@ -137,6 +137,8 @@ typedef struct {
   unsigned picture_width;   /* output.picture.width [pixels], default 800 */
   int picture_range_set;
   double picture_range[2]; /* output.picture.range: colour scale limits (default: auto) */
+  int picture_box_set;
+  double picture_box_min[2], picture_box_max[2]; /* output.picture.box (default: domain) */
   /* bookkeeping */
   char *name; /* name: default the file's base name without extension (the
                  folder's name for a file called scene.yaml) */
