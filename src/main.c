@@ -92,7 +92,6 @@ typedef struct {
   const char *out;
   rhod_scene *sc;
   rhod_sim sim;
-  rhod_host_copy hc;
   rhod_param_list params;
   rhod_csv csv;
   int csv_open;
@@ -102,29 +101,15 @@ typedef struct {
   double *probe_vals;
   unsigned nprobe_cols;
   const char *probe_names[64];
+  char probe_buf[64][RHOD_PROBE_NAME_MAX];
   char where[256];
 } run_ctx;
 
 static int write_output(run_ctx *c, char *err, size_t len) {
   rhod_sim *s = &c->sim;
-  int st = rhod_sim_fetch(s, &c->hc);
-  if (st != RHOD_OK) {
-    snprintf(err, len, "out of memory copying the particles for output");
-    return st;
-  }
-  rhod_snapshot_view v = {.time = s->t,
-                          .n = s->p.n,
-                          .x = c->hc.x,
-                          .y = c->hc.y,
-                          .ux = c->hc.ux,
-                          .uy = c->hc.uy,
-                          .rho = c->hc.rho,
-                          .p = c->hc.p,
-                          .m = c->hc.m,
-                          .size = c->hc.dx,
-                          .id = c->hc.id,
-                          .fs = c->hc.fs};
-  st = rhod_write_snapshot(c->out, c->nsnap, &v, &c->params, err, len);
+  rhod_snapshot_view v;
+  rhod_sim_fetch(s, &v);
+  int st = rhod_write_snapshot(c->out, c->nsnap, &v, &c->params, err, len);
   if (st != RHOD_OK)
     return st;
   if (c->nsnap >= c->snap_cap) {
@@ -281,7 +266,7 @@ static int cmd_run(int argc, char **argv) {
     }
   }
   rhod_scene_params(c.sc, &c.params);
-  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_names, 64);
+  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, 64);
   c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
   snprintf(path, sizeof path, "%s/probes.csv", out);
   st = rhod_csv_open(&c.csv, path, c.nprobe_cols, c.probe_names, err, sizeof err);
@@ -388,7 +373,6 @@ cleanup:
   if (g_log)
     fclose(g_log);
   g_log = NULL;
-  rhod_host_copy_free(&c.hc);
   rhod_param_list_free(&c.params);
   free(c.snap_t);
   free(c.snap_n);

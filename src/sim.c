@@ -386,35 +386,15 @@ mem:
   return st;
 }
 
-static const char *probe_kind_name(rhod_probe_kind k) {
-  switch (k) {
-  case RHOD_PROBE_PRESSURE:
-    return "pressure";
-  case RHOD_PROBE_KINETIC_ENERGY:
-    return "kinetic_energy";
-  case RHOD_PROBE_POTENTIAL_ENERGY:
-    return "potential_energy";
-  case RHOD_PROBE_FRONT:
-    return "front";
-  case RHOD_PROBE_MASS:
-    return "mass";
-  case RHOD_PROBE_MOMENTUM:
-    return "momentum";
-  case RHOD_PROBE_ANGULAR_MOMENTUM:
-    return "angular_momentum";
-  }
-  return "probe";
-}
-
-unsigned rhod_probe_columns(const rhod_scene *sc, const char **names, unsigned max) {
-  static char buf[64][80];
+unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MAX],
+                            const char **names, unsigned max) {
   unsigned k = 0;
   for (unsigned i = 0; i < sc->n_probes && k < max; i++) {
     const rhod_probe *pr = &sc->probes[i];
-    const char *nm = pr->name ? pr->name : probe_kind_name(pr->kind);
+    const char *nm = pr->name; /* the loader names every probe */
     if (pr->kind == RHOD_PROBE_MOMENTUM) {
-      for (int a = 0; a < 2 && k < max && k < 64; a++) {
-        snprintf(buf[k], sizeof buf[k], "%s_%c", nm, a ? 'y' : 'x');
+      for (int a = 0; a < 2 && k < max; a++) {
+        snprintf(buf[k], RHOD_PROBE_NAME_MAX, "%s_%c", nm, a ? 'y' : 'x');
         names[k] = buf[k];
         k++;
       }
@@ -509,45 +489,26 @@ void rhod_probe_values(rhod_sim *s, double *values) {
   }
 }
 
-int rhod_sim_fetch(rhod_sim *s, rhod_host_copy *h) {
+void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
   rhod_particles *p = &s->p;
   const size_t n = p->n;
-  if (h->cap < n) {
-    rhod_host_copy_free(h);
-    h->cap = n + n / 4 + 16;
-#define A(f, t) h->f = malloc(h->cap * sizeof(t))
-    A(x, real);
-    A(y, real);
-    A(ux, real);
-    A(uy, real);
-    A(rho, real);
-    A(p, real);
-    A(m, real);
-    A(dx, real);
-    A(id, uint64_t);
-    A(fs, uint8_t);
-#undef A
-    if (!h->x || !h->y || !h->ux || !h->uy || !h->rho || !h->p || !h->m || !h->dx || !h->id ||
-        !h->fs)
-      return RHOD_ERR_MEMORY;
-  }
-  /* P and fs were computed for the prepared state: fill_state refreshes P */
+  /* P is refreshed for the prepared state; fs is the last stage's detection */
   rhod_sph_fill_state(&s->sph, p);
-  const real *src[8] = {p->x, p->y, p->ux, p->uy, p->rho, s->sph.P, p->m, p->dx};
-  real *dst[8] = {h->x, h->y, h->ux, h->uy, h->rho, h->p, h->m, h->dx};
-  for (int k = 0; k < 8; k++) {
-    rhod_to_host((void *)src[k], n * sizeof(real));
-    memcpy(dst[k], src[k], n * sizeof(real));
-  }
+  real *const f[8] = {p->x, p->y, p->ux, p->uy, p->rho, s->sph.P, p->m, p->dx};
+  for (int k = 0; k < 8; k++)
+    rhod_to_host(f[k], n * sizeof(real));
   rhod_to_host(p->id, n * sizeof(uint64_t));
-  memcpy(h->id, p->id, n * sizeof(uint64_t));
   rhod_to_host(s->sph.fs, n);
-  memcpy(h->fs, s->sph.fs, n);
-  return RHOD_OK;
-}
-
-void rhod_host_copy_free(rhod_host_copy *h) {
-  free(h->x), free(h->y), free(h->ux), free(h->uy), free(h->rho), free(h->p), free(h->m);
-  free(h->dx), free(h->id), free(h->fs);
-  memset(h, 0, sizeof *h);
+  *v = (rhod_snapshot_view){.time = s->t,
+                            .n = n,
+                            .x = p->x,
+                            .y = p->y,
+                            .ux = p->ux,
+                            .uy = p->uy,
+                            .rho = p->rho,
+                            .p = s->sph.P,
+                            .m = p->m,
+                            .size = p->dx,
+                            .id = p->id,
+                            .fs = s->sph.fs};
 }

@@ -6,6 +6,7 @@
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/integrator.h"
+#include "rhod/io.h"
 #include "rhod/particles.h"
 #include "rhod/scene.h"
 #include "rhod/sph.h"
@@ -39,18 +40,15 @@ int rhod_sim_prepare(rhod_sim *s, int sort);
  * particle left the domain; the state is then left as computed (not written out). */
 int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen);
 
-/* Probe columns: names and values at the current (prepared) state. */
-unsigned rhod_probe_columns(const rhod_scene *sc, const char **names, unsigned max);
+/* Probe columns: names (momentum probes give two, NAME_x and NAME_y, written into the
+ * caller's buf) and values at the current (prepared) state. */
+#define RHOD_PROBE_NAME_MAX 80
+unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MAX],
+                            const char **names, unsigned max);
 void rhod_probe_values(rhod_sim *s, double *values);
 
-/* Host copies of the fluid for output (arrays owned by the caller's buffers). */
-typedef struct {
-  real *x, *y, *ux, *uy, *rho, *p, *m, *dx;
-  uint64_t *id;
-  uint8_t *fs;
-  size_t cap;
-} rhod_host_copy;
-int rhod_sim_fetch(rhod_sim *s, rhod_host_copy *h);
-void rhod_host_copy_free(rhod_host_copy *h);
+/* Brings the fluid's output fields to the host and points a snapshot view at them
+ * (valid until the next step). */
+void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v);
 
 #endif
