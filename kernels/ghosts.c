@@ -8,7 +8,11 @@
 
 /* Mirrors of (x, y) in the walls within R: positions, Jacobians J and velocity
  * transforms T (row-major 2x2). Free slip: T = J (normal velocity reversed); no slip:
- * T = -I (both components reversed, wall at rest). Returns the count. */
+ * T = -I (both components reversed, wall at rest). Returns the count; with gx NULL it
+ * only counts. The outputs are written straight into the ghost arrays (gx[k], J[4k]):
+ * a local array here would sit in GCC 12's per-warp nvptx frame, shared by the 32
+ * lanes of a simd loop, and the lanes would overwrite each other's mirrors
+ * (tools/check_offload_frames.sh guards against any such array in a kernel). */
 static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner, int ncorner,
                                const real *circ, int ncirc, real x, real y, real R, real *gx,
                                real *gy, real *J, real *T) {
@@ -23,18 +27,20 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       continue;
     if (s < 32)
       near |= 1u << s;
-    gx[n] = x - 2 * d * S[2];
-    gy[n] = y - 2 * d * S[3];
-    real *Jn = J + 4 * n, *Tn = T + 4 * n;
-    Jn[0] = 1 - 2 * S[2] * S[2];
-    Jn[1] = -2 * S[2] * S[3];
-    Jn[2] = Jn[1];
-    Jn[3] = 1 - 2 * S[3] * S[3];
-    if (S[7] != 0) {
-      Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
-    } else {
-      for (int k = 0; k < 4; k++)
-        Tn[k] = Jn[k];
+    if (gx) {
+      gx[n] = x - 2 * d * S[2];
+      gy[n] = y - 2 * d * S[3];
+      real *Jn = J + 4 * n, *Tn = T + 4 * n;
+      Jn[0] = 1 - 2 * S[2] * S[2];
+      Jn[1] = -2 * S[2] * S[3];
+      Jn[2] = Jn[1];
+      Jn[3] = 1 - 2 * S[3] * S[3];
+      if (S[7] != 0) {
+        Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+      } else {
+        for (int k = 0; k < 4; k++)
+          Tn[k] = Jn[k];
+      }
     }
     n++;
   }
@@ -50,22 +56,23 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     const real x2 = x1 - 2 * db * B[2], y2 = y1 - 2 * db * B[3];
     if ((x2 - x) * (x2 - x) + (y2 - y) * (y2 - y) >= R * R)
       continue;
-    gx[n] = x2;
-    gy[n] = y2;
-    const real Ja[4] = {1 - 2 * A[2] * A[2], -2 * A[2] * A[3], -2 * A[2] * A[3],
-                        1 - 2 * A[3] * A[3]};
-    const real Jb[4] = {1 - 2 * B[2] * B[2], -2 * B[2] * B[3], -2 * B[2] * B[3],
-                        1 - 2 * B[3] * B[3]};
-    real *Jn = J + 4 * n, *Tn = T + 4 * n;
-    Jn[0] = Jb[0] * Ja[0] + Jb[1] * Ja[2];
-    Jn[1] = Jb[0] * Ja[1] + Jb[1] * Ja[3];
-    Jn[2] = Jb[2] * Ja[0] + Jb[3] * Ja[2];
-    Jn[3] = Jb[2] * Ja[1] + Jb[3] * Ja[3];
-    if (A[7] != 0 || B[7] != 0) {
-      Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
-    } else {
-      for (int k = 0; k < 4; k++)
-        Tn[k] = Jn[k];
+    if (gx) {
+      gx[n] = x2;
+      gy[n] = y2;
+      /* J = Jb Ja, each a reflection I - 2 e e^T (symmetric) */
+      const real a0 = 1 - 2 * A[2] * A[2], a1 = -2 * A[2] * A[3], a3 = 1 - 2 * A[3] * A[3];
+      const real b0 = 1 - 2 * B[2] * B[2], b1 = -2 * B[2] * B[3], b3 = 1 - 2 * B[3] * B[3];
+      real *Jn = J + 4 * n, *Tn = T + 4 * n;
+      Jn[0] = b0 * a0 + b1 * a1;
+      Jn[1] = b0 * a1 + b1 * a3;
+      Jn[2] = b1 * a0 + b3 * a1;
+      Jn[3] = b1 * a1 + b3 * a3;
+      if (A[7] != 0 || B[7] != 0) {
+        Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+      } else {
+        for (int k = 0; k < 4; k++)
+          Tn[k] = Jn[k];
+      }
     }
     n++;
   }
@@ -81,20 +88,22 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     const real rg = C[3] > 0 ? C[2] + d : C[2] - d; /* mirror radius */
     if (!(rg > 0))
       continue;
-    const real ex = rx / dist, ey = ry / dist;
-    gx[n] = C[0] + rg * ex;
-    gy[n] = C[1] + rg * ey;
-    /* local mirror in the tangent line */
-    real *Jn = J + 4 * n, *Tn = T + 4 * n;
-    Jn[0] = 1 - 2 * ex * ex;
-    Jn[1] = -2 * ex * ey;
-    Jn[2] = Jn[1];
-    Jn[3] = 1 - 2 * ey * ey;
-    if (C[4] != 0) {
-      Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
-    } else {
-      for (int k = 0; k < 4; k++)
-        Tn[k] = Jn[k];
+    if (gx) {
+      const real ex = rx / dist, ey = ry / dist;
+      gx[n] = C[0] + rg * ex;
+      gy[n] = C[1] + rg * ey;
+      /* local mirror in the tangent line */
+      real *Jn = J + 4 * n, *Tn = T + 4 * n;
+      Jn[0] = 1 - 2 * ex * ex;
+      Jn[1] = -2 * ex * ey;
+      Jn[2] = Jn[1];
+      Jn[3] = 1 - 2 * ey * ey;
+      if (C[4] != 0) {
+        Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+      } else {
+        for (int k = 0; k < 4; k++)
+          Tn[k] = Jn[k];
+      }
     }
     n++;
   }
@@ -129,10 +138,8 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
         cnt[i] = 0;
         continue;
       }
-      real gx[RHOD_MAX_GHOSTS_PER_PARTICLE], gy[RHOD_MAX_GHOSTS_PER_PARTICLE];
-      real J[4 * RHOD_MAX_GHOSTS_PER_PARTICLE], T[4 * RHOD_MAX_GHOSTS_PER_PARTICLE];
-      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i], ratio * dx[i], gx,
-                            gy, J, T);
+      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i], ratio * dx[i],
+                            NULL, NULL, NULL, NULL);
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)n + 1);
     if (total < 0)
@@ -149,23 +156,15 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       const int c = cnt[i + 1] - cnt[i];
       if (c == 0)
         continue;
-      real gx[RHOD_MAX_GHOSTS_PER_PARTICLE], gy[RHOD_MAX_GHOSTS_PER_PARTICLE];
-      real J[4 * RHOD_MAX_GHOSTS_PER_PARTICLE], T[4 * RHOD_MAX_GHOSTS_PER_PARTICLE];
-      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, gxo[i], gyo[i], ratio * gdx[i], gx, gy,
-                   J, T);
-      for (int k = 0; k < c; k++) {
-        const long g = n + cnt[i] + k;
-        gxo[g] = gx[k];
-        gyo[g] = gy[k];
+      const long base = n + cnt[i];
+      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, gxo[i], gyo[i], ratio * gdx[i],
+                   gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base);
+      for (long g = base; g < base + c; g++) {
         m[g] = m[i];
         gdx[g] = gdx[i];
         gsrc[g] = (int32_t)i;
-        for (int q = 0; q < 4; q++) {
-          gJ[4 * g + q] = J[4 * k + q];
-          gT[4 * g + q] = T[4 * k + q];
-        }
-        ge[2 * g] = gx[k] - gxo[i];
-        ge[2 * g + 1] = gy[k] - gyo[i];
+        ge[2 * g] = gxo[g] - gxo[i];
+        ge[2 * g + 1] = gyo[g] - gyo[i];
       }
     }
     return total;

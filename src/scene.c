@@ -1802,18 +1802,23 @@ static int inline_only(const ry_node *n) {
   return 1;
 }
 
+/* Appends the flow-style text of n at buf + *used; with buf NULL only counts. */
 static void inline_text(const ry_node *n, char *buf, size_t len, size_t *used) {
+#define INLINE_PUT(...)                                                                            \
+  (*used +=                                                                                        \
+   (size_t)snprintf(buf ? buf + *used : NULL, buf && *used < len ? len - *used : 0, __VA_ARGS__))
   if (n->kind == RY_SCALAR) {
-    *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "%s", n->text);
+    INLINE_PUT("%s", n->text);
     return;
   }
-  *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "[");
+  INLINE_PUT("[");
   for (unsigned i = 0; i < n->n; i++) {
     if (i)
-      *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, ", ");
+      INLINE_PUT(", ");
     inline_text(n->items[i], buf, len, used);
   }
-  *used += (size_t)snprintf(buf + *used, *used < len ? len - *used : 0, "]");
+  INLINE_PUT("]");
+#undef INLINE_PUT
 }
 
 static int param_push(rhod_param_list *p, unsigned *cap, const char *key, const char *value) {
@@ -1849,8 +1854,9 @@ static int flatten(const ry_node *n, const char *path, rhod_param_list *p, unsig
     char *buf = malloc(used + 1);
     if (!buf)
       return -1;
+    const size_t size = used + 1;
     used = 0;
-    inline_text(n, buf, SIZE_MAX, &used);
+    inline_text(n, buf, size, &used);
     int rc = param_push(p, cap, path, buf);
     free(buf);
     return rc;

@@ -9,4 +9,4 @@ if ! "$RHOD" run "$SRC/cases/$CASE/scene.yaml" -o "$OUT" "$@" >"$OUT/.stdout" 2>
   tail -5 "$OUT/.stdout"
   exit 1
 fi
-/usr/bin/python3 "$SRC/cases/$CASE/check" "$OUT"
+"${PYTHON:-/usr/bin/python3}" "$SRC/cases/$CASE/check" "$OUT"
