@@ -1,16 +1,24 @@
-/* RK4 over registered state arrays: y_{n+1} = y_n + dt/6 (k1 + 2 k2 + 2 k3 + k4). */
+/* Explicit Runge-Kutta over registered state arrays (integrator.h):
+ * RK4 y_{n+1} = y_n + dt/6 (k1 + 2 k2 + 2 k3 + k4), stages at y_n + (dt/2, dt/2, dt) k;
+ * RK2 (Heun) y_{n+1} = y_n + dt/2 (k1 + k2), k2 at y_n + dt k1. */
 #include "rhod/integrator.h"
 #include "rhod/scene.h"
 #include <string.h>
 
-int rhod_rk4_init(rhod_rk4 *rk, rhod_particles *p) {
+/* Butcher weights (times their divisor) and the next stage's fraction of dt */
+static const real rk4_w[4] = {1, 2, 2, 1}, rk4_c[4] = {0.5, 0.5, 1, 0};
+static const real rk2_w[2] = {1, 1}, rk2_c[2] = {1, 0};
+
+int rhod_rk_init(rhod_rk *rk, rhod_particles *p, rhod_integrator_kind method) {
   (void)p;
   memset(rk, 0, sizeof *rk);
+  rk->method = method;
+  rk->stages = method == RHOD_INTEGRATOR_RK2 ? 2 : 4;
   return RHOD_OK;
 }
 
-int rhod_rk4_add(rhod_rk4 *rk, rhod_particles *p, real **state, real **deriv, int stride,
-                 int offset) {
+int rhod_rk_add(rhod_rk *rk, rhod_particles *p, real **state, real **deriv, int stride,
+                int offset) {
   if (rk->nvars >= RHOD_RK_MAX_VARS)
     return RHOD_ERR_MEMORY;
   const int k = rk->nvars;
@@ -27,7 +35,7 @@ int rhod_rk4_add(rhod_rk4 *rk, rhod_particles *p, real **state, real **deriv, in
   return st;
 }
 
-void rhod_rk4_begin(rhod_rk4 *rk, const rhod_particles *p) {
+void rhod_rk_begin(rhod_rk *rk, const rhod_particles *p) {
   const long n = (long)p->n;
   for (int v = 0; v < rk->nvars; v++) {
     const real *y = *rk->state[v];
@@ -40,12 +48,12 @@ void rhod_rk4_begin(rhod_rk4 *rk, const rhod_particles *p) {
   }
 }
 
-void rhod_rk4_stage(rhod_rk4 *rk, const rhod_particles *p, int s, real dt) {
-  static const real w[4] = {1, 2, 2, 1};     /* weights x 6 */
-  static const real c[4] = {0.5, 0.5, 1, 0}; /* next stage's fraction of dt */
+void rhod_rk_stage(rhod_rk *rk, const rhod_particles *p, int s, real dt) {
+  const int rk2 = rk->method == RHOD_INTEGRATOR_RK2;
+  const real *w = rk2 ? rk2_w : rk4_w, *c = rk2 ? rk2_c : rk4_c;
   const long n = (long)p->n;
-  const real ws = w[s], cs = c[s] * dt, d6 = dt / 6;
-  const int last = s == 3;
+  const real ws = w[s], cs = c[s] * dt, d6 = dt / (rk2 ? 2 : 6);
+  const int last = s == rk->stages - 1;
   for (int v = 0; v < rk->nvars; v++) {
     real *y = *rk->state[v];
     const real *d = *rk->deriv[v];

@@ -141,7 +141,14 @@ static int write_dataset(h5_reason *R, hid_t loc, const char *name, hid_t ftype,
     return -1;
   }
   int rc = -1;
-  hid_t d = H5Dcreate2(loc, name, ftype, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  /* no modification times in the file: the same state gives the same bytes (restarts
+   * are checked byte for byte) */
+  hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+  hid_t d = -1;
+  if (dcpl >= 0 && H5Pset_obj_track_times(dcpl, 0) >= 0)
+    d = H5Dcreate2(loc, name, ftype, sp, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+  if (dcpl >= 0)
+    H5Pclose(dcpl);
   if (d < 0) {
     note(R);
   } else {
@@ -172,8 +179,14 @@ static void pack_xyz(double *out, const real *a, const real *b, size_t n) {
   }
 }
 
+/* gcpl: H5P_DEFAULT or the caller's; times are never tracked (see write_dataset) */
 static hid_t create_group(h5_reason *R, hid_t loc, const char *name, hid_t gcpl) {
-  hid_t g = H5Gcreate2(loc, name, H5P_DEFAULT, gcpl, H5P_DEFAULT);
+  hid_t own = gcpl == H5P_DEFAULT ? H5Pcreate(H5P_GROUP_CREATE) : gcpl;
+  hid_t g = -1;
+  if (own >= 0 && H5Pset_obj_track_times(own, 0) >= 0)
+    g = H5Gcreate2(loc, name, H5P_DEFAULT, own, H5P_DEFAULT);
+  if (own >= 0 && own != gcpl)
+    H5Pclose(own);
   if (g < 0)
     note(R);
   return g;

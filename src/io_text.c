@@ -1,7 +1,7 @@
 /* Text outputs: atomic whole-file writes (path.tmp, fsync, rename) and the probes CSV,
  * which stays open and is flushed after every row. Every write is checked, so a full
  * disk is reported as "FILE: cannot write: No space left on device". */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* truncate */
 
 #include "rhod/io.h"
 
@@ -157,6 +157,28 @@ int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *con
     e = flush_check(f);
   if (e) {
     (void)fclose(f);
+    free(c->path);
+    c->path = NULL;
+    return fail(err, errlen, path, e);
+  }
+  c->f = f;
+  c->ncols = ncols;
+  return RHOD_OK;
+}
+
+int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
+                    size_t errlen) {
+  memset(c, 0, sizeof *c);
+  c->path = strdup(path);
+  if (!c->path) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot write: out of memory", path);
+    return RHOD_ERR_MEMORY;
+  }
+  errno = 0;
+  FILE *f = NULL;
+  if (bytes == 0 || truncate(path, (off_t)bytes) != 0 || !(f = fopen(path, "a"))) {
+    int e = errno ? errno : EIO;
     free(c->path);
     c->path = NULL;
     return fail(err, errlen, path, e);

@@ -1,10 +1,13 @@
 /* rhod: command line. The only place that prints to the terminal and exits. */
+#define _XOPEN_SOURCE 700 /* realpath, sigaction types */
+#include "rhod/checkpoint.h"
 #include "rhod/io.h"
 #include "rhod/scene.h"
 #include "rhod/sim.h"
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,12 +19,21 @@
 #define ERRLEN 1024
 
 static const char *USAGE =
-    "usage: rhod run SCENE [-o OUT] [--set dotted.key=value]...\n"
+    "usage: rhod run SCENE [-o OUT] [--set dotted.key=value]... [--checkpoint-every T]\n"
+    "       rhod resume OUT\n"
     "       rhod --help | --version\n"
     "Runs the scene and writes snapshots (HDF5 + XDMF), pictures (PNG), probes.csv,\n"
     "summary.json and run.log to OUT (default out/<scene file's folder name>).\n"
+    "--checkpoint-every T writes OUT/checkpoint.rhod every T simulated seconds; SIGINT or\n"
+    "SIGTERM writes one and stops. `rhod resume OUT` continues from it, bit for bit.\n"
     "Exit codes: 0 ok, 2 usage, 3 unreadable scene, 4 invalid scene, 5 output folder,\n"
-    "6 unstable run, 7 write error during the run, 8 out of memory.\n";
+    "6 unstable run, 7 write error during the run, 8 out of memory, 9 interrupted\n"
+    "(checkpoint written), 10 bad or unfitting checkpoint.\n";
+
+/* SIGINT/SIGTERM: the loop stops after the step in progress, writes a checkpoint and
+ * exits with RHOD_ERR_INTERRUPTED. */
+static volatile sig_atomic_t g_stop;
+static void on_signal(int sig) { g_stop = sig; }
 
 static FILE *g_log;
 
@@ -103,7 +115,47 @@ typedef struct {
   const char *probe_names[64];
   char probe_buf[64][RHOD_PROBE_NAME_MAX];
   char where[256];
+  /* checkpoints */
+  const char *scene_arg;
+  const char **sets;
+  int nsets;
+  double ck_every, next_ck;
+  long step0; /* steps done before this process (a resume) */
 } run_ctx;
+
+/* OUT/checkpoint.rhod: the state at the top of the loop, after the outputs of time t. */
+static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char *err, size_t len) {
+  rhod_checkpoint ck;
+  memset(&ck, 0, sizeof ck);
+  ck.t = c->sim.t;
+  ck.next_out = next_out;
+  ck.next_probe = next_probe;
+  ck.next_checkpoint = c->next_ck;
+  ck.checkpoint_every = c->ck_every;
+  ck.step = c->sim.step;
+  ck.reflected = c->sim.reflected;
+  long pos = c->csv.f ? ftell(c->csv.f) : -1;
+  ck.probes_bytes = pos > 0 ? (uint64_t)pos : 0;
+  ck.nsnap = c->nsnap;
+  ck.snap_t = c->snap_t;
+  uint64_t *sn = malloc(sizeof(uint64_t) * (size_t)(c->nsnap + 1));
+  if (!sn) {
+    snprintf(err, len, "out of memory writing a checkpoint");
+    return RHOD_ERR_MEMORY;
+  }
+  for (int i = 0; i < c->nsnap; i++)
+    sn[i] = c->snap_n[i];
+  ck.snap_n = sn;
+  ck.scene_path = (char *)c->scene_arg;
+  ck.nsets = c->nsets;
+  ck.sets = (char **)c->sets;
+  ck.params = c->params;
+  char path[4200];
+  snprintf(path, sizeof path, "%s/checkpoint.rhod", c->out);
+  int st = rhod_checkpoint_write(path, &ck, &c->sim.p, err, len);
+  free(sn);
+  return st;
+}
 
 static int write_output(run_ctx *c, char *err, size_t len) {
   rhod_sim *s = &c->sim;
@@ -139,7 +191,7 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
   rhod_sim *s = &c->sim;
   char buf[16384];
   size_t o = 0;
-  const double psteps = (double)s->p.n * (double)s->step;
+  const double psteps = (double)s->p.n * (double)(s->step - c->step0);
   o += (size_t)snprintf(buf + o, sizeof buf - o,
                         "{\n  \"status\": \"%s\",\n  \"cause\": \"%s\",\n  \"scene\": \"%s\",\n"
                         "  \"particles\": %zu,\n  \"steps\": %ld,\n  \"time\": %.9g,\n"
@@ -162,10 +214,29 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
   return st;
 }
 
-static int cmd_run(int argc, char **argv) {
+static int cmd_run(int argc, char **argv, const char *resume_out) {
   const char *scene = NULL, *out = NULL;
   const char *sets[256];
   int nsets = 0;
+  double ck_every = 0;
+  rhod_checkpoint ck;
+  memset(&ck, 0, sizeof ck);
+  char err[ERRLEN] = "";
+  if (resume_out) {
+    char path[4200];
+    snprintf(path, sizeof path, "%s/checkpoint.rhod", resume_out);
+    int st = rhod_checkpoint_read(path, &ck, err, sizeof err);
+    if (st != RHOD_OK) {
+      fprintf(stderr, "rhod: %s\n", err);
+      return st;
+    }
+    scene = ck.scene_path;
+    out = resume_out;
+    nsets = ck.nsets < 256 ? ck.nsets : 256;
+    for (int i = 0; i < nsets; i++)
+      sets[i] = ck.sets[i];
+    ck_every = ck.checkpoint_every;
+  }
   for (int i = 0; i < argc; i++) {
     if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
       if (++i >= argc) {
@@ -183,6 +254,13 @@ static int cmd_run(int argc, char **argv) {
         return RHOD_ERR_USAGE;
       }
       sets[nsets++] = argv[i];
+    } else if (!strcmp(argv[i], "--checkpoint-every")) {
+      char *end = NULL;
+      ck_every = ++i < argc ? strtod(argv[i], &end) : 0;
+      if (i >= argc || !end || *end || !(ck_every > 0) || !isfinite(ck_every)) {
+        fprintf(stderr, "rhod: --checkpoint-every needs a time in seconds > 0\n%s", USAGE);
+        return RHOD_ERR_USAGE;
+      }
     } else if (!strncmp(argv[i], "--set=", 6)) {
       if (nsets < 256)
         sets[nsets++] = argv[i] + 6;
@@ -200,12 +278,18 @@ static int cmd_run(int argc, char **argv) {
     fprintf(stderr, "rhod: run needs a scene file\n%s", USAGE);
     return RHOD_ERR_USAGE;
   }
-  char err[ERRLEN] = "";
   run_ctx c;
   memset(&c, 0, sizeof c);
+  /* the checkpoint keeps the scene's absolute path, so a resume works from anywhere */
+  char scene_abs[4096];
+  c.scene_arg = !resume_out && realpath(scene, scene_abs) ? scene_abs : scene;
+  c.sets = sets;
+  c.nsets = nsets;
+  c.ck_every = ck_every;
   int st = rhod_scene_load(scene, sets, nsets, &c.sc, err, sizeof err);
   if (st != RHOD_OK) {
     fprintf(stderr, "rhod: %s\n", err);
+    rhod_checkpoint_free(&ck);
     return st;
   }
   char outbuf[4096];
@@ -231,9 +315,39 @@ static int cmd_run(int argc, char **argv) {
   const int nw = rhod_scene_warnings(c.sc, warn, sizeof warn);
   /* set up the particles before touching OUT: a scene that fails here writes nothing */
   st = rhod_sim_init(&c.sim, c.sc, err, sizeof err);
+  if (st == RHOD_OK && resume_out) {
+    /* the scene must be the one checkpointed, key for key */
+    rhod_param_list now_params;
+    st = rhod_scene_params(c.sc, &now_params) == RHOD_OK ? RHOD_OK : RHOD_ERR_MEMORY;
+    for (unsigned i = 0; st == RHOD_OK && i < now_params.n + 1; i++) {
+      const int in_now = i < now_params.n, in_ck = i < ck.params.n;
+      if (!in_now && !in_ck)
+        break;
+      if (in_now != in_ck || strcmp(now_params.keys[i], ck.params.keys[i]) ||
+          strcmp(now_params.values[i], ck.params.values[i])) {
+        snprintf(err, sizeof err,
+                 "%.400s: the scene changed since the checkpoint in %.400s (key %.100s)", scene,
+                 resume_out, in_ck ? ck.params.keys[i] : now_params.keys[i]);
+        st = RHOD_ERR_CHECKPOINT;
+      }
+    }
+    rhod_param_list_free(&now_params);
+    if (st == RHOD_OK)
+      st = rhod_checkpoint_apply(&ck, &c.sim.p, err, sizeof err);
+    if (st == RHOD_OK) {
+      c.sim.t = ck.t;
+      c.sim.step = ck.step;
+      c.sim.reflected = ck.reflected;
+      st = rhod_sim_prepare(&c.sim, 1);
+      if (st != RHOD_OK)
+        snprintf(err, sizeof err, "out of memory for ghost particles");
+    }
+  }
   if (st != RHOD_OK) {
     fprintf(stderr, "rhod: %s\n", err);
+    rhod_sim_free(&c.sim);
     rhod_scene_free(c.sc);
+    rhod_checkpoint_free(&ck);
     return st;
   }
   st = check_output_dir(out, err, sizeof err);
@@ -241,11 +355,12 @@ static int cmd_run(int argc, char **argv) {
     fprintf(stderr, "rhod: %s\n", err);
     rhod_sim_free(&c.sim);
     rhod_scene_free(c.sc);
+    rhod_checkpoint_free(&ck);
     return st;
   }
   char path[4200];
   snprintf(path, sizeof path, "%s/run.log", out);
-  g_log = fopen(path, "w");
+  g_log = fopen(path, resume_out ? "a" : "w");
   if (!g_log) {
     fprintf(stderr, "rhod: %s: cannot write: %s\n", path, strerror(errno));
     return RHOD_ERR_OUTPUT;
@@ -253,7 +368,10 @@ static int cmd_run(int argc, char **argv) {
   rhod_where(c.where, sizeof c.where);
   rhod_sim *s = &c.sim;
   const double t0 = now();
+  c.step0 = s->step;
   const int tty = isatty(2);
+  if (resume_out)
+    logline("rhod: resumed from %s/checkpoint.rhod at t = %.9g s (step %ld)", out, s->t, s->step);
   logline("rhod: scene %s -> %s", c.sc->path, out);
   logline("rhod: kernels run on: %s", c.where);
   logline("rhod: %zu fluid particles, dx = %g m, R = %g m, dt = %.4g s, %s precision", s->p.n,
@@ -269,13 +387,34 @@ static int cmd_run(int argc, char **argv) {
   c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, 64);
   c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
   snprintf(path, sizeof path, "%s/probes.csv", out);
-  st = rhod_csv_open(&c.csv, path, c.nprobe_cols, c.probe_names, err, sizeof err);
+  if (resume_out)
+    st = rhod_csv_reopen(&c.csv, path, c.nprobe_cols, ck.probes_bytes, err, sizeof err);
+  else
+    st = rhod_csv_open(&c.csv, path, c.nprobe_cols, c.probe_names, err, sizeof err);
   if (st != RHOD_OK)
     goto fail;
   c.csv_open = 1;
 
   const double t_end = c.sc->t_end, dout = c.sc->output_every, dprobe = c.sc->probe_every;
   double next_out = 0, next_probe = 0;
+  c.next_ck = ck_every;
+  if (resume_out) {
+    next_out = ck.next_out, next_probe = ck.next_probe, c.next_ck = ck.next_checkpoint;
+    c.snap_cap = ck.nsnap + 16;
+    c.snap_t = malloc(sizeof(double) * (size_t)c.snap_cap);
+    c.snap_n = malloc(sizeof(size_t) * (size_t)c.snap_cap);
+    if (!c.snap_t || !c.snap_n) {
+      st = RHOD_ERR_MEMORY;
+      snprintf(err, sizeof err, "out of memory");
+      goto fail;
+    }
+    for (int i = 0; i < ck.nsnap; i++)
+      c.snap_t[i] = ck.snap_t[i], c.snap_n[i] = (size_t)ck.snap_n[i];
+    c.nsnap = ck.nsnap;
+  }
+  g_stop = 0;
+  signal(SIGINT, on_signal);
+  signal(SIGTERM, on_signal);
   double last_progress = -1;
   int last_decile = -1;
   const double eps = 1e-9 * t_end;
@@ -299,6 +438,20 @@ static int cmd_run(int argc, char **argv) {
     }
     if (done)
       break;
+    if ((c.ck_every > 0 && s->t >= c.next_ck - eps) || g_stop) {
+      while (c.ck_every > 0 && c.next_ck <= s->t + eps)
+        c.next_ck += c.ck_every;
+      st = write_checkpoint(&c, next_out, next_probe, err, sizeof err);
+      if (st != RHOD_OK)
+        goto fail;
+      if (g_stop) {
+        logline("rhod: %s at t = %.9g s: checkpoint written; continue with: rhod resume %s",
+                g_stop == SIGINT ? "interrupted" : "terminated", s->t, out);
+        write_summary(&c, "interrupted", "signal", now() - t0);
+        st = RHOD_ERR_INTERRUPTED;
+        goto cleanup;
+      }
+    }
     double dt = s->dt;
     /* land exactly on output times and on the end */
     const double stop = fmin(t_end, next_out);
@@ -321,10 +474,10 @@ static int cmd_run(int argc, char **argv) {
       last_decile = (int)(frac * 10);
       char eta[32];
       fmt_hms(frac > 0 ? w * (1 - frac) / frac : 0, eta, sizeof eta);
-      fprintf(stderr,
-              "%st = %.5g s  %5.1f%%  N = %zu  dt = %.3g s  %.3g particle-steps/s  ETA %s%s",
-              tty ? "\r" : "", s->t, 100 * frac, s->p.n, s->dt,
-              (double)s->p.n * (double)s->step / (w > 0 ? w : 1), eta, tty ? "   " : "\n");
+      fprintf(
+          stderr, "%st = %.5g s  %5.1f%%  N = %zu  dt = %.3g s  %.3g particle-steps/s  ETA %s%s",
+          tty ? "\r" : "", s->t, 100 * frac, s->p.n, s->dt,
+          (double)s->p.n * (double)(s->step - c.step0) / (w > 0 ? w : 1), eta, tty ? "   " : "\n");
       fflush(stderr);
     }
   }
@@ -332,7 +485,7 @@ static int cmd_run(int argc, char **argv) {
     fprintf(stderr, "\n");
   {
     const double wall = now() - t0;
-    const double psteps = (double)s->p.n * (double)s->step;
+    const double psteps = (double)s->p.n * (double)(s->step - c.step0);
     logline("rhod: done: %ld steps, %.3f s wall, %.4g us per particle-step", s->step, wall,
             psteps > 0 ? 1e6 * wall / psteps : 0.0);
     if (s->reflected)
@@ -363,6 +516,9 @@ fail:
               c.nsnap - 1, c.nsnap ? c.snap_t[c.nsnap - 1] : 0.0);
   }
 cleanup:
+  signal(SIGINT, SIG_DFL);
+  signal(SIGTERM, SIG_DFL);
+  rhod_checkpoint_free(&ck);
   if (c.csv_open) {
     char e2[ERRLEN];
     if (rhod_csv_close(&c.csv, e2, sizeof e2) != RHOD_OK && st == RHOD_OK) {
@@ -398,7 +554,14 @@ int main(int argc, char **argv) {
     return 0;
   }
   if (!strcmp(argv[1], "run"))
-    return cmd_run(argc - 2, argv + 2);
+    return cmd_run(argc - 2, argv + 2, NULL);
+  if (!strcmp(argv[1], "resume")) {
+    if (argc != 3) {
+      fprintf(stderr, "rhod: resume needs exactly one output folder\n%s", USAGE);
+      return RHOD_ERR_USAGE;
+    }
+    return cmd_run(0, NULL, argv[2]);
+  }
   fprintf(stderr, "rhod: unknown command '%s'\n%s", argv[1], USAGE);
   return RHOD_ERR_USAGE;
 }

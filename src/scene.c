@@ -75,6 +75,7 @@ typedef struct {
 typedef struct {
   double end, output_every;
   double *cfl, *cfl_visc;
+  int *integrator;
 } y_time;
 
 typedef struct {
@@ -189,6 +190,10 @@ static const cyaml_strval_t kernel_names[] = {
     {"wendland_c4", RHOD_KERNEL_WENDLAND_C4},
     {"quintic", RHOD_KERNEL_QUINTIC},
 };
+static const cyaml_strval_t integrator_names[] = {
+    {"rk4", RHOD_INTEGRATOR_RK4},
+    {"rk2", RHOD_INTEGRATOR_RK2},
+};
 static const cyaml_strval_t init_names[] = {
     {"uniform", RHOD_INIT_UNIFORM},
     {"hydrostatic", RHOD_INIT_HYDROSTATIC},
@@ -212,6 +217,7 @@ static const cyaml_schema_field_t f_time[] = {
     NUM("output_every", y_time, output_every),
     NUM_OPT("cfl", y_time, cfl),
     NUM_OPT("cfl_visc", y_time, cfl_visc),
+    ENUM_OPT("integrator", y_time, integrator, integrator_names),
     CYAML_FIELD_END,
 };
 
@@ -1170,6 +1176,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->output_every = d->time.output_every;
   s->cfl = opt(d->time.cfl, 0.5);
   s->cfl_visc = opt(d->time.cfl_visc, 0.025);
+  s->integrator =
+      d->time.integrator ? (rhod_integrator_kind)*d->time.integrator : RHOD_INTEGRATOR_RK4;
   TRY(check_positive(c, "time.end", s->t_end));
   TRY(check_positive(c, "time.output_every", s->output_every));
   TRY(check_range(c, "time.cfl", s->cfl, 0, 1, 1, 0));
@@ -1531,6 +1539,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "output_every", s->output_every);
   tb_num(&t, m, "cfl", s->cfl);
   tb_num(&t, m, "cfl_visc", s->cfl_visc);
+  tb_word(&t, m, "integrator",
+          strval_name(integrator_names, CYAML_ARRAY_LEN(integrator_names), (int)s->integrator));
   m = tb_coll(&t, root, "particles", RY_MAP, 0);
   tb_num(&t, m, "dx", s->dx);
   tb_num(&t, m, "radius_ratio", s->radius_ratio);

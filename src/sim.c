@@ -219,19 +219,19 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     return st;
   st = rhod_sph_init(&s->sph, sc, &s->p);
   if (st == RHOD_OK)
-    st = rhod_rk4_init(&s->rk, &s->p);
+    st = rhod_rk_init(&s->rk, &s->p, s->sc->integrator);
   rhod_particles *p = &s->p;
   rhod_sph *h = &s->sph;
   if (st == RHOD_OK)
-    st = rhod_rk4_add(&s->rk, p, &p->x, &h->vel, 2, 0);
+    st = rhod_rk_add(&s->rk, p, &p->x, &h->vel, 2, 0);
   if (st == RHOD_OK)
-    st = rhod_rk4_add(&s->rk, p, &p->y, &h->vel, 2, 1);
+    st = rhod_rk_add(&s->rk, p, &p->y, &h->vel, 2, 1);
   if (st == RHOD_OK)
-    st = rhod_rk4_add(&s->rk, p, &p->ux, &h->acc, 2, 0);
+    st = rhod_rk_add(&s->rk, p, &p->ux, &h->acc, 2, 0);
   if (st == RHOD_OK)
-    st = rhod_rk4_add(&s->rk, p, &p->uy, &h->acc, 2, 1);
+    st = rhod_rk_add(&s->rk, p, &p->uy, &h->acc, 2, 1);
   if (st == RHOD_OK)
-    st = rhod_rk4_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
+    st = rhod_rk_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
   if (st != RHOD_OK) {
     snprintf(err, errlen, "out of memory setting up the scheme");
     return st;
@@ -366,15 +366,15 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
     if (st != RHOD_OK)
       goto mem;
   }
-  rhod_rk4_begin(&s->rk, p);
-  for (int stage = 0; stage < 4; stage++) {
+  rhod_rk_begin(&s->rk, p);
+  for (int stage = 0; stage < s->rk.stages; stage++) {
     if (stage > 0) {
       st = rhod_sim_prepare(s, 0);
       if (st != RHOD_OK)
         goto mem;
     }
     rhod_sph_rhs(&s->sph, p, &s->cells, (real)dt);
-    rhod_rk4_stage(&s->rk, p, stage, (real)dt);
+    rhod_rk_stage(&s->rk, p, stage, (real)dt);
   }
   s->neighbours_fresh = 0;
   s->reflected += rhod_walls_guard(&s->bnd, p);

@@ -74,6 +74,10 @@ typedef struct {
 } rhod_csv;
 int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *const *names,
                   char *err, size_t errlen);
+/* Reopens an existing probes.csv for appending after cutting it to `bytes` (its length
+ * at a checkpoint: rows written after it are dropped, the resumed run writes them again). */
+int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
+                    size_t errlen);
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen);
 int rhod_csv_close(rhod_csv *c, char *err, size_t errlen);
 

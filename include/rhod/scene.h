@@ -8,13 +8,15 @@
 /* Exit codes, one per class of failure (documented in docs/scene.md and the README). */
 enum rhod_status {
   RHOD_OK = 0,
-  RHOD_ERR_USAGE = 2,    /* bad command line */
-  RHOD_ERR_READ = 3,     /* scene file missing or unreadable */
-  RHOD_ERR_SCENE = 4,    /* scene malformed: syntax, unknown key, wrong type, bad value */
-  RHOD_ERR_OUTPUT = 5,   /* output folder cannot be created or written */
-  RHOD_ERR_UNSTABLE = 6, /* the run went unstable: NaN/inf or a particle left the domain */
-  RHOD_ERR_IO = 7,       /* an output file could not be written during the run */
-  RHOD_ERR_MEMORY = 8,   /* allocation failed */
+  RHOD_ERR_USAGE = 2,       /* bad command line */
+  RHOD_ERR_READ = 3,        /* scene file missing or unreadable */
+  RHOD_ERR_SCENE = 4,       /* scene malformed: syntax, unknown key, wrong type, bad value */
+  RHOD_ERR_OUTPUT = 5,      /* output folder cannot be created or written */
+  RHOD_ERR_UNSTABLE = 6,    /* the run went unstable: NaN/inf or a particle left the domain */
+  RHOD_ERR_IO = 7,          /* an output file could not be written during the run */
+  RHOD_ERR_MEMORY = 8,      /* allocation failed */
+  RHOD_ERR_INTERRUPTED = 9, /* stopped by SIGINT/SIGTERM after writing a checkpoint */
+  RHOD_ERR_CHECKPOINT = 10, /* a checkpoint is missing, corrupt or does not fit the scene */
 };
 
 typedef enum { RHOD_SHAPE_RECT = 0, RHOD_SHAPE_POLYGON, RHOD_SHAPE_CIRCLE } rhod_shape_kind;
@@ -82,6 +84,12 @@ typedef enum {
   RHOD_KERNEL_QUINTIC
 } rhod_kernel_kind;
 
+/* time.integrator: the explicit Runge-Kutta method of the step (integrator.h) */
+typedef enum {
+  RHOD_INTEGRATOR_RK4 = 0, /* classical, 4 right-hand sides per step (paper 002 Sec. IV A) */
+  RHOD_INTEGRATOR_RK2      /* Heun (SSP-RK2), 2 right-hand sides per step: our option */
+} rhod_integrator_kind;
+
 typedef enum {
   RHOD_FIELD_PRESSURE = 0,
   RHOD_FIELD_VELOCITY, /* magnitude */
@@ -92,10 +100,11 @@ typedef enum {
 
 typedef struct {
   /* time: */
-  double t_end;        /* time.end [s] (required) */
-  double output_every; /* time.output_every [s] (required) */
-  double cfl;          /* time.cfl, CFL_h of Eq. 11, default 0.5 */
-  double cfl_visc;     /* time.cfl_visc, CFL_mu of Eq. 11, default 0.025 */
+  double t_end;                    /* time.end [s] (required) */
+  double output_every;             /* time.output_every [s] (required) */
+  double cfl;                      /* time.cfl, CFL_h of Eq. 11, default 0.5 */
+  double cfl_visc;                 /* time.cfl_visc, CFL_mu of Eq. 11, default 0.025 */
+  rhod_integrator_kind integrator; /* time.integrator, default rk4 */
   /* particles: */
   double dx;               /* particles.dx [m] (required) */
   double radius_ratio;     /* particles.radius_ratio = R/dx, default 4 (paper 002 Sec. IV D) */

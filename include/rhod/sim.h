@@ -17,7 +17,7 @@ typedef struct {
   rhod_boundary bnd;
   rhod_cells cells;
   rhod_sph sph;
-  rhod_rk4 rk;
+  rhod_rk rk;
   double lo[2], hi[2]; /* domain box */
   double margin;       /* ghost layer width: largest kernel radius */
   double t, dt;

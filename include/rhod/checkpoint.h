@@ -1,0 +1,54 @@
+/* Checkpoints: everything a run needs to continue bit for bit (issue 5): the
+ * persistent particle arrays as stored (full precision, in their current order), the
+ * particle store's id counter, the run's clock and output bookkeeping, and the scene as
+ * run (path, --set overrides and the flattened parameters, so that a resume can refuse a
+ * scene that changed). Engine level: it knows registered fields, not physics.
+ *
+ * File layout (native byte order, this build's `real`): "RHODCKP1", u32 version,
+ * u32 sizeof(real), then length-prefixed records (see checkpoint.c), then a 64-bit
+ * FNV-1a hash of everything before it. Written in memory and through
+ * rhod_write_bytes_atomic, so a crash or a full disk never leaves a torn file. */
+#ifndef RHOD_CHECKPOINT_H
+#define RHOD_CHECKPOINT_H
+
+#include "rhod/particles.h"
+#include "rhod/scene.h"
+#include <stdint.h>
+
+typedef struct {
+  /* run state */
+  double t, next_out, next_probe, next_checkpoint, checkpoint_every;
+  int64_t step, reflected;
+  uint64_t probes_bytes; /* length of probes.csv when the checkpoint was taken */
+  int32_t nsnap;
+  double *snap_t;
+  uint64_t *snap_n;
+  /* scene as run */
+  char *scene_path;
+  int32_t nsets;
+  char **sets;
+  rhod_param_list params;
+  /* particles (filled by rhod_checkpoint_read; the writer takes them from the store) */
+  uint64_t n, next_id;
+  int32_t nfields;
+  char **fname;
+  uint64_t *felem;
+  void **fdata;
+} rhod_checkpoint;
+
+/* Writes ck's run state and scene plus every persistent field of p ([0, n), copied
+ * from the device first) to path. Errors: RHOD_ERR_IO ("path: cannot write: reason"),
+ * RHOD_ERR_MEMORY. */
+int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_particles *p, char *err,
+                          size_t errlen);
+/* Reads and validates a checkpoint (every length against the file, the hash, the
+ * precision). Errors: RHOD_ERR_CHECKPOINT ("path: reason"), RHOD_ERR_MEMORY; ck is
+ * then empty. */
+int rhod_checkpoint_read(const char *path, rhod_checkpoint *ck, char *err, size_t errlen);
+/* Puts the checkpoint's particles into p (same persistent fields, in the same order,
+ * with the same sizes) and onto the device. Errors: RHOD_ERR_CHECKPOINT, RHOD_ERR_MEMORY. */
+int rhod_checkpoint_apply(const rhod_checkpoint *ck, rhod_particles *p, char *err, size_t errlen);
+/* Frees what rhod_checkpoint_read allocated (an emptied or zeroed one is fine). */
+void rhod_checkpoint_free(rhod_checkpoint *ck);
+
+#endif

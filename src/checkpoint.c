@@ -1,0 +1,388 @@
+/* Checkpoint writing and reading (checkpoint.h). Records in order:
+ *   "RHODCKP1" u32 version u32 sizeof(real)
+ *   f64 t next_out next_probe next_checkpoint checkpoint_every
+ *   i64 step reflected   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
+ *   str scene_path   i32 nsets, str[nsets]   u32 nparams, (str key, str value)[nparams]
+ *   u64 n next_id   i32 nfields, per field: str name, u64 elem, elem * n bytes
+ *   u64 FNV-1a hash of all the bytes above
+ * where str is a u32 length and that many bytes (no terminator). The reader checks every
+ * count against the bytes left, so a damaged or hostile file fails with a message. */
+#include "rhod/checkpoint.h"
+#include "rhod/io.h"
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CK_MAGIC "RHODCKP1"
+#define CK_VERSION 1u
+#define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
+
+static uint64_t fnv1a(const unsigned char *b, size_t n) {
+  uint64_t h = 1469598103934665603ull;
+  for (size_t i = 0; i < n; i++) {
+    h ^= b[i];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+/* ------------------------------------------------------------------ writing */
+
+typedef struct {
+  unsigned char *b;
+  size_t len, cap;
+  int oom;
+} buf;
+
+static void put(buf *w, const void *src, size_t n) {
+  if (w->oom)
+    return;
+  if (w->len + n > w->cap) {
+    size_t cap = 2 * w->cap + n + 4096;
+    unsigned char *b = realloc(w->b, cap);
+    if (!b) {
+      w->oom = 1;
+      return;
+    }
+    w->b = b, w->cap = cap;
+  }
+  memcpy(w->b + w->len, src, n);
+  w->len += n;
+}
+
+static void put_u32(buf *w, uint32_t v) { put(w, &v, sizeof v); }
+static void put_i32(buf *w, int32_t v) { put(w, &v, sizeof v); }
+static void put_u64(buf *w, uint64_t v) { put(w, &v, sizeof v); }
+static void put_i64(buf *w, int64_t v) { put(w, &v, sizeof v); }
+static void put_f64(buf *w, double v) { put(w, &v, sizeof v); }
+static void put_str(buf *w, const char *s) {
+  const size_t n = s ? strlen(s) : 0;
+  put_u32(w, (uint32_t)n);
+  put(w, s, n);
+}
+
+int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_particles *p, char *err,
+                          size_t errlen) {
+  buf w = {0};
+  put(&w, CK_MAGIC, 8);
+  put_u32(&w, CK_VERSION);
+  put_u32(&w, (uint32_t)sizeof(real));
+  put_f64(&w, ck->t);
+  put_f64(&w, ck->next_out);
+  put_f64(&w, ck->next_probe);
+  put_f64(&w, ck->next_checkpoint);
+  put_f64(&w, ck->checkpoint_every);
+  put_i64(&w, ck->step);
+  put_i64(&w, ck->reflected);
+  put_u64(&w, ck->probes_bytes);
+  put_i32(&w, ck->nsnap);
+  put(&w, ck->snap_t, sizeof(double) * (size_t)ck->nsnap);
+  put(&w, ck->snap_n, sizeof(uint64_t) * (size_t)ck->nsnap);
+  put_str(&w, ck->scene_path);
+  put_i32(&w, ck->nsets);
+  for (int i = 0; i < ck->nsets; i++)
+    put_str(&w, ck->sets[i]);
+  put_u32(&w, ck->params.n);
+  for (unsigned i = 0; i < ck->params.n; i++) {
+    put_str(&w, ck->params.keys[i]);
+    put_str(&w, ck->params.values[i]);
+  }
+  put_u64(&w, p->n);
+  put_u64(&w, p->next_id);
+  int32_t nf = 0;
+  for (int f = 0; f < p->nfields; f++)
+    nf += p->fields[f].persistent != 0;
+  put_i32(&w, nf);
+  for (int f = 0; f < p->nfields; f++) {
+    const rhod_field_desc *d = &p->fields[f];
+    if (!d->persistent)
+      continue;
+    rhod_to_host(*d->ptr, p->n * d->elem);
+    put_str(&w, d->name);
+    put_u64(&w, d->elem);
+    put(&w, *d->ptr, p->n * d->elem);
+  }
+  if (!w.oom)
+    put_u64(&w, fnv1a(w.b, w.len));
+  int rc;
+  if (w.oom) {
+    snprintf(err, errlen, "%s: cannot write: out of memory", path);
+    rc = RHOD_ERR_MEMORY;
+  } else {
+    rc = rhod_write_bytes_atomic(path, w.b, w.len, err, errlen);
+  }
+  free(w.b);
+  return rc;
+}
+
+/* ------------------------------------------------------------------ reading */
+
+typedef struct {
+  const unsigned char *b;
+  size_t len, pos;
+  int bad;
+  const char *what; /* the first record that did not fit */
+} rd;
+
+static void get(rd *r, void *dst, size_t n, const char *what) {
+  if (r->bad)
+    return;
+  if (n > r->len - r->pos) {
+    r->bad = 1;
+    r->what = what;
+    return;
+  }
+  memcpy(dst, r->b + r->pos, n);
+  r->pos += n;
+}
+
+static uint32_t get_count(rd *r, const char *what) {
+  uint32_t v = 0;
+  get(r, &v, sizeof v, what);
+  if (!r->bad && v > CK_MAX_COUNT) {
+    r->bad = 1;
+    r->what = what;
+    return 0;
+  }
+  return v;
+}
+
+static char *get_str(rd *r, const char *what) {
+  const uint32_t n = get_count(r, what);
+  if (r->bad || n > r->len - r->pos) {
+    r->bad = 1;
+    r->what = what;
+    return NULL;
+  }
+  char *s = malloc((size_t)n + 1);
+  if (!s) {
+    r->bad = 2;
+    return NULL;
+  }
+  memcpy(s, r->b + r->pos, n);
+  s[n] = 0;
+  r->pos += n;
+  if (strlen(s) != n) { /* an embedded NUL */
+    r->bad = 1;
+    r->what = what;
+  }
+  return s;
+}
+
+static void *get_array(rd *r, uint64_t count, size_t elem, const char *what) {
+  if (r->bad)
+    return NULL;
+  if (count > CK_MAX_COUNT || (elem && count > (r->len - r->pos) / elem)) {
+    r->bad = 1;
+    r->what = what;
+    return NULL;
+  }
+  const size_t bytes = (size_t)count * elem;
+  void *a = malloc(bytes ? bytes : 1);
+  if (!a) {
+    r->bad = 2;
+    return NULL;
+  }
+  get(r, a, bytes, what);
+  return a;
+}
+
+static int read_fail(char *err, size_t errlen, const char *path, const char *fmt, ...) {
+  char msg[512];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  snprintf(err, errlen, "%s: %s", path, msg);
+  return RHOD_ERR_CHECKPOINT;
+}
+
+static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t errlen) {
+  char magic[8];
+  uint32_t version = 0, rsize = 0;
+  get(r, magic, 8, "magic");
+  if (r->bad || memcmp(magic, CK_MAGIC, 8) != 0)
+    return read_fail(err, errlen, path, "not an rhod checkpoint");
+  get(r, &version, 4, "version");
+  get(r, &rsize, 4, "precision");
+  if (r->bad)
+    return read_fail(err, errlen, path, "truncated header");
+  if (version != CK_VERSION)
+    return read_fail(err, errlen, path, "checkpoint version %u, this rhod reads %u", version,
+                     CK_VERSION);
+  if (rsize != sizeof(real))
+    return read_fail(err, errlen, path, "written by a %s-precision build, this one is %s",
+                     rsize == 4 ? "single" : "double", RHOD_REAL_NAME);
+  get(r, &ck->t, 8, "time");
+  get(r, &ck->next_out, 8, "next output time");
+  get(r, &ck->next_probe, 8, "next probe time");
+  get(r, &ck->next_checkpoint, 8, "next checkpoint time");
+  get(r, &ck->checkpoint_every, 8, "checkpoint interval");
+  get(r, &ck->step, 8, "step");
+  get(r, &ck->reflected, 8, "reflection count");
+  get(r, &ck->probes_bytes, 8, "probes.csv length");
+  ck->nsnap = (int32_t)get_count(r, "snapshot count");
+  ck->snap_t = get_array(r, (uint64_t)ck->nsnap, sizeof(double), "snapshot times");
+  ck->snap_n = get_array(r, (uint64_t)ck->nsnap, sizeof(uint64_t), "snapshot sizes");
+  ck->scene_path = get_str(r, "scene path");
+  ck->nsets = (int32_t)get_count(r, "override count");
+  if (!r->bad && !(ck->sets = calloc((size_t)ck->nsets + 1, sizeof(char *))))
+    r->bad = 2;
+  for (int i = 0; i < ck->nsets && !r->bad && ck->sets; i++)
+    ck->sets[i] = get_str(r, "override");
+  const uint32_t np = get_count(r, "parameter count");
+  if (!r->bad) {
+    ck->params.keys = calloc((size_t)np + 1, sizeof(char *));
+    ck->params.values = calloc((size_t)np + 1, sizeof(char *));
+    if (!ck->params.keys || !ck->params.values)
+      r->bad = 2;
+  }
+  for (uint32_t i = 0; i < np && !r->bad; i++) {
+    ck->params.keys[i] = get_str(r, "parameter key");
+    ck->params.values[i] = get_str(r, "parameter value");
+    ck->params.n = i + 1;
+  }
+  get(r, &ck->n, 8, "particle count");
+  get(r, &ck->next_id, 8, "next id");
+  ck->nfields = (int32_t)get_count(r, "field count");
+  if (!r->bad && ck->nfields > RHOD_MAX_FIELDS) {
+    r->bad = 1;
+    r->what = "field count";
+  }
+  if (!r->bad) {
+    ck->fname = calloc((size_t)ck->nfields + 1, sizeof(char *));
+    ck->felem = calloc((size_t)ck->nfields + 1, sizeof(uint64_t));
+    ck->fdata = calloc((size_t)ck->nfields + 1, sizeof(void *));
+    if (!ck->fname || !ck->felem || !ck->fdata)
+      r->bad = 2;
+  }
+  for (int f = 0; f < ck->nfields && !r->bad; f++) {
+    ck->fname[f] = get_str(r, "field name");
+    get(r, &ck->felem[f], 8, "field element size");
+    if (!r->bad && (ck->felem[f] == 0 || ck->felem[f] > 4096)) {
+      r->bad = 1;
+      r->what = "field element size";
+      break;
+    }
+    ck->fdata[f] = get_array(r, ck->n, (size_t)ck->felem[f], "field data");
+  }
+  if (r->bad == 2) {
+    snprintf(err, errlen, "%s: out of memory", path);
+    return RHOD_ERR_MEMORY;
+  }
+  if (r->bad)
+    return read_fail(err, errlen, path, "damaged: %s does not fit in the file", r->what);
+  if (r->len - r->pos != 8)
+    return read_fail(err, errlen, path, "damaged: the checksum is missing or not at the end");
+  uint64_t h;
+  memcpy(&h, r->b + r->pos, 8);
+  if (h != fnv1a(r->b, r->pos))
+    return read_fail(err, errlen, path, "damaged: checksum mismatch");
+  if (!(ck->t >= 0) || ck->step < 0 || ck->nsnap < 0)
+    return read_fail(err, errlen, path, "damaged: negative time, step or snapshot count");
+  return RHOD_OK;
+}
+
+int rhod_checkpoint_read(const char *path, rhod_checkpoint *ck, char *err, size_t errlen) {
+  memset(ck, 0, sizeof *ck);
+  FILE *f = fopen(path, "rb");
+  if (!f)
+    return read_fail(err, errlen, path, "cannot open the checkpoint");
+  unsigned char *b = NULL;
+  size_t len = 0, cap = 0;
+  for (;;) {
+    if (len == cap) {
+      cap = 2 * cap + (1u << 20);
+      unsigned char *nb = realloc(b, cap);
+      if (!nb) {
+        free(b);
+        fclose(f);
+        snprintf(err, errlen, "%s: out of memory", path);
+        return RHOD_ERR_MEMORY;
+      }
+      b = nb;
+    }
+    const size_t got = fread(b + len, 1, cap - len, f);
+    len += got;
+    if (got == 0)
+      break;
+  }
+  const int rerr = ferror(f);
+  fclose(f);
+  if (rerr) {
+    free(b);
+    return read_fail(err, errlen, path, "read error");
+  }
+  rd r = {b, len, 0, 0, NULL};
+  int rc = parse(&r, ck, path, err, errlen);
+  free(b);
+  if (rc != RHOD_OK)
+    rhod_checkpoint_free(ck);
+  return rc;
+}
+
+int rhod_checkpoint_apply(const rhod_checkpoint *ck, rhod_particles *p, char *err, size_t errlen) {
+  int k = 0;
+  for (int f = 0; f < p->nfields; f++) {
+    const rhod_field_desc *d = &p->fields[f];
+    if (!d->persistent)
+      continue;
+    if (k >= ck->nfields || strcmp(ck->fname[k], d->name) != 0 || ck->felem[k] != d->elem) {
+      snprintf(err, errlen, "checkpoint fields do not match this build's (field %d: %s)", k,
+               k < ck->nfields ? ck->fname[k] : "missing");
+      return RHOD_ERR_CHECKPOINT;
+    }
+    k++;
+  }
+  if (k != ck->nfields) {
+    snprintf(err, errlen, "checkpoint has %d fields, this build %d", ck->nfields, k);
+    return RHOD_ERR_CHECKPOINT;
+  }
+  if (ck->n + 1 > p->cap && rhod_particles_reserve(p, (size_t)ck->n + 1) != RHOD_OK) {
+    snprintf(err, errlen, "out of memory for %llu particles", (unsigned long long)ck->n);
+    return RHOD_ERR_MEMORY;
+  }
+  p->n = (size_t)ck->n;
+  p->ng = 0;
+  p->next_id = ck->next_id;
+  k = 0;
+  for (int f = 0; f < p->nfields; f++) {
+    const rhod_field_desc *d = &p->fields[f];
+    if (!d->persistent)
+      continue;
+    memcpy(*d->ptr, ck->fdata[k], p->n * d->elem);
+    rhod_to_device(*d->ptr, p->n * d->elem);
+    k++;
+  }
+  return RHOD_OK;
+}
+
+void rhod_checkpoint_free(rhod_checkpoint *ck) {
+  if (!ck)
+    return;
+  free(ck->snap_t);
+  free(ck->snap_n);
+  free(ck->scene_path);
+  for (int i = 0; ck->sets && i < ck->nsets; i++)
+    free(ck->sets[i]);
+  free(ck->sets);
+  for (unsigned i = 0; i < ck->params.n; i++) {
+    if (ck->params.keys)
+      free(ck->params.keys[i]);
+    if (ck->params.values)
+      free(ck->params.values[i]);
+  }
+  free(ck->params.keys);
+  free(ck->params.values);
+  for (int f = 0; f < ck->nfields; f++) {
+    if (ck->fname)
+      free(ck->fname[f]);
+    if (ck->fdata)
+      free(ck->fdata[f]);
+  }
+  free(ck->fname);
+  free(ck->felem);
+  free(ck->fdata);
+  memset(ck, 0, sizeof *ck);
+}
