@@ -314,9 +314,16 @@ int rhod_checkpoint_read(const char *path, rhod_checkpoint *ck, char *err, size_
     free(b);
     return read_fail(err, errlen, path, "read error");
   }
-  rd r = {b, len, 0, 0, NULL};
-  int rc = parse(&r, ck, path, err, errlen);
+  int rc = rhod_checkpoint_parse(b, len, path, ck, err, errlen);
   free(b);
+  return rc;
+}
+
+int rhod_checkpoint_parse(const void *bytes, size_t len, const char *name, rhod_checkpoint *ck,
+                          char *err, size_t errlen) {
+  memset(ck, 0, sizeof *ck);
+  rd r = {bytes, len, 0, 0, NULL};
+  int rc = parse(&r, ck, name, err, errlen);
   if (rc != RHOD_OK)
     rhod_checkpoint_free(ck);
   return rc;

@@ -45,6 +45,9 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
  * precision). Errors: RHOD_ERR_CHECKPOINT ("path: reason"), RHOD_ERR_MEMORY; ck is
  * then empty. */
 int rhod_checkpoint_read(const char *path, rhod_checkpoint *ck, char *err, size_t errlen);
+/* The same from bytes in memory (`name` is used in messages); the fuzz target. */
+int rhod_checkpoint_parse(const void *bytes, size_t len, const char *name, rhod_checkpoint *ck,
+                          char *err, size_t errlen);
 /* Puts the checkpoint's particles into p (same persistent fields, in the same order,
  * with the same sizes) and onto the device. Errors: RHOD_ERR_CHECKPOINT, RHOD_ERR_MEMORY. */
 int rhod_checkpoint_apply(const rhod_checkpoint *ck, rhod_particles *p, char *err, size_t errlen);
