@@ -227,11 +227,21 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   ck->snap_n = get_array(r, (uint64_t)ck->nsnap, sizeof(uint64_t), "snapshot sizes");
   ck->scene_path = get_str(r, "scene path");
   ck->nsets = (int32_t)get_count(r, "override count");
+  /* every string takes at least its 4-byte length: bound counts by the bytes left
+   * before allocating (a hostile count must not cost memory) */
+  if (!r->bad && (size_t)ck->nsets > (r->len - r->pos) / 4) {
+    r->bad = 1;
+    r->what = "override count";
+  }
   if (!r->bad && !(ck->sets = calloc((size_t)ck->nsets + 1, sizeof(char *))))
     r->bad = 2;
   for (int i = 0; i < ck->nsets && !r->bad && ck->sets; i++)
     ck->sets[i] = get_str(r, "override");
   const uint32_t np = get_count(r, "parameter count");
+  if (!r->bad && np > (r->len - r->pos) / 8) {
+    r->bad = 1;
+    r->what = "parameter count";
+  }
   if (!r->bad) {
     ck->params.keys = calloc((size_t)np + 1, sizeof(char *));
     ck->params.values = calloc((size_t)np + 1, sizeof(char *));

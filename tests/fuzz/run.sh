@@ -11,7 +11,7 @@ RUNS=${2:-1000000}
 JOBS=${3:-1}
 command -v clang >/dev/null || { echo "run.sh: needs clang (apt-get install clang libomp-14-dev)" >&2; exit 2; }
 B=build-fuzz
-mkdir -p "$B"
+mkdir -p "$B" "tests/fuzz/corpus/$TARGET"
 # shellcheck disable=SC2046
 clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -fopenmp \
   -Iinclude -Ikernels -Isrc $(pkg-config --cflags hdf5 libcyaml libpng) \
@@ -20,5 +20,7 @@ clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
 CORPUS=tests/fuzz/corpus/$TARGET
 SEEDS=()
 [ "$TARGET" = scene ] && SEEDS=(tests/scenes/good tests/scenes/bad)
-"$B/fuzz_$TARGET" -runs="$RUNS" -jobs="$JOBS" -workers="$JOBS" -max_len=65536 \
-  -print_final_stats=1 "$CORPUS" "${SEEDS[@]}" 2>&1 | tail -25
+PAR=()
+[ "$JOBS" -gt 1 ] && PAR=(-jobs="$JOBS" -workers="$JOBS") # then each job logs to fuzz-N.log
+"$B/fuzz_$TARGET" -runs="$RUNS" "${PAR[@]}" -max_len=65536 -print_final_stats=1 \
+  "$CORPUS" "${SEEDS[@]}" 2>&1 | tail -25
