@@ -124,8 +124,8 @@ static int flush_check(FILE *f) {
   return 0;
 }
 
-int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *const *names,
-                  char *err, size_t errlen) {
+/* Clears c and keeps a copy of path for messages. */
+static int csv_start(rhod_csv *c, const char *path, char *err, size_t errlen) {
   memset(c, 0, sizeof *c);
   c->path = strdup(path);
   if (!c->path) {
@@ -133,14 +133,32 @@ int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *con
       snprintf(err, errlen, "%s: cannot write: out of memory", path);
     return RHOD_ERR_MEMORY;
   }
-  errno = 0;
-  FILE *f = fopen(path, "w");
-  if (!f) {
-    int e = errno ? errno : EIO;
+  return RHOD_OK;
+}
+
+/* Ends an open: on error e (an errno) closes f, forgets the path and reports. */
+static int csv_finish(rhod_csv *c, FILE *f, unsigned ncols, int e, char *err, size_t errlen) {
+  if (e) {
+    if (f)
+      (void)fclose(f);
+    const int rc = fail(err, errlen, c->path, e);
     free(c->path);
     c->path = NULL;
-    return fail(err, errlen, path, e);
+    return rc;
   }
+  c->f = f;
+  c->ncols = ncols;
+  return RHOD_OK;
+}
+
+int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *const *names,
+                  char *err, size_t errlen) {
+  if (csv_start(c, path, err, errlen) != RHOD_OK)
+    return RHOD_ERR_MEMORY;
+  errno = 0;
+  FILE *f = fopen(path, "w");
+  if (!f)
+    return csv_finish(c, NULL, ncols, errno ? errno : EIO, err, errlen);
   int e = 0;
   errno = 0;
   if (fputc('t', f) == EOF)
@@ -155,37 +173,19 @@ int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *con
     e = errno ? errno : EIO;
   if (!e)
     e = flush_check(f);
-  if (e) {
-    (void)fclose(f);
-    free(c->path);
-    c->path = NULL;
-    return fail(err, errlen, path, e);
-  }
-  c->f = f;
-  c->ncols = ncols;
-  return RHOD_OK;
+  return csv_finish(c, f, ncols, e, err, errlen);
 }
 
 int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
                     size_t errlen) {
-  memset(c, 0, sizeof *c);
-  c->path = strdup(path);
-  if (!c->path) {
-    if (err && errlen)
-      snprintf(err, errlen, "%s: cannot write: out of memory", path);
+  if (csv_start(c, path, err, errlen) != RHOD_OK)
     return RHOD_ERR_MEMORY;
-  }
   errno = 0;
   FILE *f = NULL;
-  if (bytes == 0 || truncate(path, (off_t)bytes) != 0 || !(f = fopen(path, "a"))) {
-    int e = errno ? errno : EIO;
-    free(c->path);
-    c->path = NULL;
-    return fail(err, errlen, path, e);
-  }
-  c->f = f;
-  c->ncols = ncols;
-  return RHOD_OK;
+  int e = 0;
+  if (bytes == 0 || truncate(path, (off_t)bytes) != 0 || !(f = fopen(path, "a")))
+    e = errno ? errno : EIO;
+  return csv_finish(c, f, ncols, e, err, errlen);
 }
 
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen) {

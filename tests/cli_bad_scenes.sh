@@ -5,9 +5,8 @@
 # run left exactly as it was (test_scene checks each message's line, key and reason).
 set -uo pipefail
 RHOD=$1; SRC=$2
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail=0; pass=0
+# shellcheck source=lib_cli.sh
+source "$(dirname "$0")/lib_cli.sh"
 # a previous run's folder, to be left alone by every failing run
 "$RHOD" run "$SRC/tests/scenes/run/periodic_uniform.yaml" -o "$T/out" >/dev/null 2>&1 ||
   { echo "FAIL: setting up the previous run"; exit 1; }
@@ -34,5 +33,4 @@ if cmp -s "$T/before" "$T/after"; then pass=$((pass + 1)); else
   echo "FAIL: a failing run changed the output folder"; diff "$T/before" "$T/after" | head; fail=$((fail + 1))
 fi
 [ $n -ge 30 ] || { echo "FAIL: only $n bad scenes (30 wanted)"; fail=$((fail + 1)); }
-echo "$n bad scenes: $pass passed, $fail failed"
-[ $fail -eq 0 ]
+summary "$n bad scenes"

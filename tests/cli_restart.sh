@@ -5,20 +5,8 @@
 # checkpoints are refused with a one-line message and their own exit code.
 set -uo pipefail
 RHOD=$1; SRC=$2
-T=$(mktemp -d)
-trap 'rm -rf "$T"' EXIT
-fail=0; pass=0
-expect() { # expect CODE DESCRIPTION -- command...
-  local code=$1 what=$2; shift 3
-  "$@" >"$T/stdout" 2>"$T/stderr"; local got=$?
-  if [ "$got" -ne "$code" ]; then
-    echo "FAIL: $what: exit $got, expected $code"; tail -3 "$T/stderr"; fail=$((fail + 1))
-  else pass=$((pass + 1)); fi
-}
-check() { # check DESCRIPTION -- command...
-  local what=$1; shift 2
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $what"; fail=$((fail + 1)); fi
-}
+# shellcheck source=lib_cli.sh
+source "$(dirname "$0")/lib_cli.sh"
 same_outputs() { # same_outputs A B: every snapshot, picture, xdmf and probes.csv equal
   local a=$1 b=$2 f n=0
   for f in "$a"/snapshot_*.h5 "$a"/snapshot_*.png "$a"/snapshots.xdmf "$a"/probes.csv; do
@@ -78,5 +66,4 @@ check "changed key named" -- grep -q "scene changed since the checkpoint.*physic
 check "refused resume left the outputs alone" -- same_outputs "$T/a" "$T/d"
 expect 2 "bad --checkpoint-every" -- "$RHOD" run "$T/scene.yaml" --checkpoint-every -1
 
-echo "$pass passed, $fail failed"
-[ $fail -eq 0 ]
+summary restart

@@ -4,20 +4,8 @@
 # cause named and no NaN written.
 set -uo pipefail
 RHOD=$1; SRC=$2
-T=$(mktemp -d)
-trap 'chmod -R u+w "$T"; rm -rf "$T"' EXIT
-fail=0; pass=0
-expect() { # expect CODE DESCRIPTION -- command...
-  local code=$1 what=$2; shift 3
-  "$@" >"$T/stdout" 2>"$T/stderr"; local got=$?
-  if [ "$got" -ne "$code" ]; then
-    echo "FAIL: $what: exit $got, expected $code"; cat "$T/stderr"; fail=$((fail + 1))
-  else pass=$((pass + 1)); fi
-}
-check() { # check DESCRIPTION -- command...
-  local what=$1; shift 2
-  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $what"; fail=$((fail + 1)); fi
-}
+# shellcheck source=lib_cli.sh
+source "$(dirname "$0")/lib_cli.sh"
 SCENE=$SRC/cases/hydrostatic/scene.yaml
 SHORT=(--set particles.dx=0.05 --set time.end=0.1 --set time.output_every=0.05)
 
@@ -76,5 +64,4 @@ for s in snaps:
                 sys.exit(f"{s}: {k} not finite")
 PY
 
-echo "cli: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+summary cli
