@@ -9,6 +9,7 @@
  * count against the bytes left, so a damaged or hostile file fails with a message. */
 #include "rhod/checkpoint.h"
 #include "rhod/io.h"
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -296,34 +297,15 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
 
 int rhod_checkpoint_read(const char *path, rhod_checkpoint *ck, char *err, size_t errlen) {
   memset(ck, 0, sizeof *ck);
-  FILE *f = fopen(path, "rb");
-  if (!f)
-    return read_fail(err, errlen, path, "cannot open the checkpoint");
-  unsigned char *b = NULL;
-  size_t len = 0, cap = 0;
-  for (;;) {
-    if (len == cap) {
-      cap = 2 * cap + (1u << 20);
-      unsigned char *nb = realloc(b, cap);
-      if (!nb) {
-        free(b);
-        fclose(f);
-        snprintf(err, errlen, "%s: out of memory", path);
-        return RHOD_ERR_MEMORY;
-      }
-      b = nb;
-    }
-    const size_t got = fread(b + len, 1, cap - len, f);
-    len += got;
-    if (got == 0)
-      break;
+  char *b = NULL;
+  size_t len = 0;
+  const int e = rhod_read_file(path, &b, &len);
+  if (e == ENOMEM) {
+    snprintf(err, errlen, "%s: out of memory", path);
+    return RHOD_ERR_MEMORY;
   }
-  const int rerr = ferror(f);
-  fclose(f);
-  if (rerr) {
-    free(b);
-    return read_fail(err, errlen, path, "read error");
-  }
+  if (e)
+    return read_fail(err, errlen, path, "cannot read the checkpoint: %s", strerror(e));
   int rc = rhod_checkpoint_parse(b, len, path, ck, err, errlen);
   free(b);
   return rc;
@@ -384,14 +366,7 @@ void rhod_checkpoint_free(rhod_checkpoint *ck) {
   for (int i = 0; ck->sets && i < ck->nsets; i++)
     free(ck->sets[i]);
   free(ck->sets);
-  for (unsigned i = 0; i < ck->params.n; i++) {
-    if (ck->params.keys)
-      free(ck->params.keys[i]);
-    if (ck->params.values)
-      free(ck->params.values[i]);
-  }
-  free(ck->params.keys);
-  free(ck->params.values);
+  rhod_param_list_free(&ck->params);
   for (int f = 0; f < ck->nfields; f++) {
     if (ck->fname)
       free(ck->fname[f]);

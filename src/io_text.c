@@ -97,6 +97,45 @@ int rhod_write_bytes_atomic(const char *path, const void *data, size_t len, char
   return RHOD_OK;
 }
 
+/* Whole files in (scene text, checkpoints): io.h. */
+int rhod_read_file(const char *path, char **text, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f)
+    return errno ? errno : EIO;
+  size_t cap = 4096, n = 0;
+  char *buf = malloc(cap);
+  int e = 0;
+  while (buf) {
+    if (n + 1 >= cap) {
+      char *nb = realloc(buf, cap *= 2);
+      if (!nb) {
+        free(buf);
+        buf = NULL;
+        break;
+      }
+      buf = nb;
+    }
+    size_t got = fread(buf + n, 1, cap - n - 1, f);
+    n += got;
+    if (got == 0) {
+      if (ferror(f))
+        e = errno ? errno : EIO;
+      break;
+    }
+  }
+  fclose(f);
+  if (!buf)
+    return ENOMEM;
+  if (e) {
+    free(buf);
+    return e;
+  }
+  buf[n] = '\0';
+  *text = buf;
+  *len = n;
+  return 0;
+}
+
 int rhod_write_file_atomic(const char *path, const char *text, char *err, size_t errlen) {
   return rhod_write_bytes_atomic(path, text, strlen(text), err, errlen);
 }

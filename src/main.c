@@ -319,17 +319,16 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     /* the scene must be the one checkpointed, key for key */
     rhod_param_list now_params;
     st = rhod_scene_params(c.sc, &now_params) == RHOD_OK ? RHOD_OK : RHOD_ERR_MEMORY;
-    for (unsigned i = 0; st == RHOD_OK && i < now_params.n + 1; i++) {
-      const int in_now = i < now_params.n, in_ck = i < ck.params.n;
-      if (!in_now && !in_ck)
-        break;
-      if (in_now != in_ck || strcmp(now_params.keys[i], ck.params.keys[i]) ||
-          strcmp(now_params.values[i], ck.params.values[i])) {
-        snprintf(err, sizeof err,
-                 "%.400s: the scene changed since the checkpoint in %.400s (key %.100s)", scene,
-                 resume_out, in_ck ? ck.params.keys[i] : now_params.keys[i]);
-        st = RHOD_ERR_CHECKPOINT;
-      }
+    const unsigned nmin = now_params.n < ck.params.n ? now_params.n : ck.params.n;
+    unsigned i = 0;
+    while (st == RHOD_OK && i < nmin && !strcmp(now_params.keys[i], ck.params.keys[i]) &&
+           !strcmp(now_params.values[i], ck.params.values[i]))
+      i++;
+    if (st == RHOD_OK && (i < nmin || now_params.n != ck.params.n)) {
+      snprintf(err, sizeof err,
+               "%.400s: the scene changed since the checkpoint in %.400s (key %.100s)", scene,
+               resume_out, i < ck.params.n ? ck.params.keys[i] : now_params.keys[i]);
+      st = RHOD_ERR_CHECKPOINT;
     }
     rhod_param_list_free(&now_params);
     if (st == RHOD_OK)

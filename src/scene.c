@@ -11,6 +11,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "rhod/scene.h"
+#include "rhod/io.h"
 
 #include "scene_yaml.h"
 
@@ -1639,44 +1640,6 @@ static ry_node *scene_tree(const rhod_scene *s) {
 
 /* ---- public API ------------------------------------------------------------------------ */
 
-static int read_all(const char *path, char **text, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f)
-    return errno ? errno : EIO;
-  size_t cap = 4096, n = 0;
-  char *buf = malloc(cap);
-  int e = 0;
-  while (buf) {
-    if (n + 1 >= cap) {
-      char *nb = realloc(buf, cap *= 2);
-      if (!nb) {
-        free(buf);
-        buf = NULL;
-        break;
-      }
-      buf = nb;
-    }
-    size_t got = fread(buf + n, 1, cap - n - 1, f);
-    n += got;
-    if (got == 0) {
-      if (ferror(f))
-        e = errno ? errno : EIO;
-      break;
-    }
-  }
-  fclose(f);
-  if (!buf)
-    return ENOMEM;
-  if (e) {
-    free(buf);
-    return e;
-  }
-  buf[n] = '\0';
-  *text = buf;
-  *len = n;
-  return 0;
-}
-
 void rhod_scene_free(rhod_scene *s) {
   if (!s)
     return;
@@ -1776,7 +1739,7 @@ int rhod_scene_load(const char *path, const char *const *overrides, int n_overri
   }
   char *text = NULL;
   size_t len = 0;
-  int e = read_all(path, &text, &len);
+  int e = rhod_read_file(path, &text, &len);
   if (e) {
     if (e == ENOMEM)
       return fail_oom(&c);

@@ -5,20 +5,20 @@
 # copies (this broke every wall ghost on a GPU while the host-fallback tests passed).
 # This compiles each source with kernels for nvptx, reads the PTX, and fails when a
 # simd body (an outlined `$_omp_fn$N` that is not a team-level `$impl`) has such a frame.
-# usage: offload_frames.sh SRC_DIR
+# usage: offload_frames.sh SRC_DIR OFFLOAD_FLAGS... (the build's own, from CMake)
 set -euo pipefail
 SRC=$(cd "$1" && pwd)
+shift
+FLAGS=("$@" -foffload-options=nvptx-none=-save-temps)
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 bad=0
 checked=0
 for f in $(grep -l -E "RHOD_KERNEL_LOOP|omp target" "$SRC"/kernels/*.c "$SRC"/src/*.c); do
   b=$(basename "$f" .c)
-  (cd "$TMP" && gcc -O2 -fopenmp -foffload=nvptx-none \
-    "-foffload-options=nvptx-none=-misa=sm_80 -lm -latomic -save-temps" \
-    -I"$SRC/include" -I"$SRC/kernels" -I"$SRC/src" -DRHOD_OFFLOAD=1 -c "$f" -o "$b.o" &&
-    gcc -fopenmp -foffload=nvptx-none "-foffload-options=nvptx-none=-misa=sm_80 -lm -latomic -save-temps" \
-      -no-pie -shared -o "$b.so" "$b.o" 2>/dev/null)
+  (cd "$TMP" && gcc -O2 "${FLAGS[@]}" -I"$SRC/include" -I"$SRC/kernels" -I"$SRC/src" \
+    -DRHOD_OFFLOAD=1 -c "$f" -o "$b.o" &&
+    gcc "${FLAGS[@]}" -no-pie -shared -o "$b.so" "$b.o" 2>/dev/null)
   # the offload image holds our module first, then libgomp's and libm's
   tr '\0' '\n' <"$TMP/$b.so.xnvptx-none.mkoffload" | awk '/^\/\/ BEGIN PREAMBLE/{n++} n==1' >"$TMP/$b.ptx"
   out=$(awk '/BEGIN FUNCTION DEF/{f=$NF}

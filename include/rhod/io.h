@@ -81,6 +81,9 @@ int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t byte
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen);
 int rhod_csv_close(rhod_csv *c, char *err, size_t errlen);
 
+/* Reads a whole file into a malloc'd buffer, NUL-terminated (len excludes the NUL).
+ * Returns 0 or an errno value (ENOMEM included); *text is untouched on failure. */
+int rhod_read_file(const char *path, char **text, size_t *len);
 /* Writes `text` to path through path.tmp + rename. */
 int rhod_write_file_atomic(const char *path, const char *text, char *err, size_t errlen);
 /* The same for `len` bytes of any data: path.tmp in the same folder is written, fsync'd,

@@ -22,7 +22,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
   rhod_scene *s = NULL;
   char err[1024];
-  if (rhod_scene_load(path, NULL, 0, &s, err, sizeof err) == RHOD_OK) {
+  const int rc = rhod_scene_load(path, NULL, 0, &s, err, sizeof err);
+  unlink(path);
+  if (rc == RHOD_OK) {
     char warn[1024];
     rhod_param_list params;
     (void)rhod_scene_warnings(s, warn, sizeof warn);
