@@ -98,6 +98,7 @@ int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], doubl
   c->g.oy = (real)lo[1];
   c->g.inv = (real)(1.0 / cw);
   c->g.reach = reach;
+  c->g.iR0 = (real)(1.0 / radius);
   c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   map_alloc(&c->start, c->ncells + 1);
   map_alloc(&c->count, c->ncells + 1);

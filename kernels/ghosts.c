@@ -119,6 +119,17 @@ static int ensure_count(rhod_boundary *b, size_t need) {
   return b->count ? RHOD_OK : RHOD_ERR_MEMORY;
 }
 
+void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real ratio, uint8_t *near) {
+  const int nseg = b->nseg, ncorner = b->ncorner, ncirc = b->ncirc;
+  const real *seg = b->seg, *circ = b->circ, *x = p->x, *y = p->y, *dx = p->dx;
+  const int32_t *corner = b->corner;
+  const long n = (long)p->n;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++)
+    near[i] = nseg + ncirc > 0 && wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i],
+                                               ratio * dx[i], NULL, NULL, NULL, NULL) > 0;
+}
+
 /* Phase 1: wall mirrors of the fluid. Returns the number of ghosts written or < 0. */
 static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
   const int nseg = b->nseg, ncorner = b->ncorner, ncirc = b->ncirc;

@@ -109,7 +109,7 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     const real iWdx = 1 / rhod_Wq(kern, dxi * iR); /* R^-2/W(dx_ij) of Eq. 29, dx_j = dx_i */
     real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
     real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0, um = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
       if (r2 < R2 && j != i) {
         const real r = sqrt(r2), ir = 1 / r;
@@ -243,7 +243,7 @@ void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells
     const real tx = -ny, ty = nx;
     const real h2 = h * h, s2h2 = 2 * h2, R2 = Ri * Ri;
     int occupied = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
       if (j != i && r2 < R2) {
         const real qx = x[j] - Tx, qy = y[j] - Ty;
@@ -308,14 +308,14 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
-    if (!rhod_cells_near_mark(G, mark, xi, yi)) {
+    if (!rhod_cells_near_mark(G, mark, xi, yi, Ri)) {
       reg[i] = 0, sig[i] = 0;
       nt[2 * i] = 0, nt[2 * i + 1] = 0;
       continue;
     }
     real sx = 0, sy = 0, dmin2 = R2;
     int any = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
       if (r2 < R2 && fs[j]) {
         const real w = rhod_W(kern, sqrt(r2), Ri);
@@ -422,7 +422,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     real cont = 0;                              /* continuity, Eq. 22 */
     real vsx = 0, vsy = 0;                      /* Eq. 10 */
     real ddu = 0, drdu = 0, ruux = 0, ruuy = 0; /* Eq. 4 */
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
       if (r2 < R2 && j != i) {
         const real r = sqrt(r2), ir = 1 / r;

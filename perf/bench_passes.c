@@ -17,7 +17,7 @@ static double count_pairs(rhod_sim *s) {
   RHOD_KERNEL_LOOP_REDUCE(+, pairs)
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], R2 = ratio * ratio * dx[i] * dx[i];
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) {
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, ratio * dx[i], j) {
       const real rx = x[j] - xi, ry = y[j] - yi;
       if (j != i && rx * rx + ry * ry < R2)
         pairs++;
@@ -56,7 +56,7 @@ int main(int argc, char **argv) {
         rhod_sim_prepare(&s, 1);
         break; /* sort + ghosts + cells */
       case 1:
-        rhod_ghosts_build(&s.bnd, p, (real)s.sc->radius_ratio, (real)s.margin);
+        rhod_ghosts_build(&s.bnd, p, (real)s.mirror_ratio, (real)s.margin);
         break;
       case 2:
         rhod_cells_build(&s.cells, p->x, p->y, p->n + p->ng);

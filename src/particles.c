@@ -152,6 +152,41 @@ static void permute_bytes(void *arr, void *scratch, const int32_t *perm, size_t 
     a[b] = dst[b];
 }
 
+/* dst[k] = a[src[k]] for k < count, one element of `elem` bytes each. */
+static void copy_from(void *arr, size_t dst0, const int32_t *src, size_t count, size_t elem) {
+  const long nn = (long)count, d0 = (long)dst0;
+  if (elem == 8) {
+    uint64_t *a = arr;
+    RHOD_KERNEL_LOOP
+    for (long k = 0; k < nn; k++)
+      a[d0 + k] = a[src[k]];
+    return;
+  }
+  if (elem == 4) {
+    uint32_t *a = arr;
+    RHOD_KERNEL_LOOP
+    for (long k = 0; k < nn; k++)
+      a[d0 + k] = a[src[k]];
+    return;
+  }
+  char *a = arr;
+  const long el = (long)elem;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nn; k++)
+    for (long b = 0; b < el; b++)
+      a[el * (d0 + k) + b] = a[el * (long)src[k] + b];
+}
+
+void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count) {
+  for (int i = 0; i < p->nfields; i++) {
+    rhod_field_desc *f = &p->fields[i];
+    if (f->persistent)
+      copy_from(*f->ptr, p->n, src, count, f->elem);
+  }
+  p->n += count;
+  p->ng = 0;
+}
+
 void rhod_particles_permute(rhod_particles *p) {
   for (int i = 0; i < p->nfields; i++) {
     rhod_field_desc *f = &p->fields[i];

@@ -136,6 +136,27 @@ typedef struct {
 } y_probe;
 
 typedef struct {
+  y_rect *rect;
+  y_circle *circle;
+  double (*polygon)[2];
+  unsigned n_polygon;
+  double level;
+} y_region;
+
+typedef struct {
+  int quantity;
+  double *above, *below, *from;
+} y_refine_field;
+
+typedef struct {
+  double *levels;
+  y_region *regions;
+  unsigned n_regions;
+  bool *dynamic, *free_surface, *walls;
+  y_refine_field *field;
+} y_refinement;
+
+typedef struct {
   double *every;
   y_probe *list;
   unsigned n_list;
@@ -165,6 +186,7 @@ typedef struct {
   unsigned n_walls;
   y_probes *probes;
   y_output *output;
+  y_refinement *refinement;
 } y_doc;
 
 /* ---- the schema ------------------------------------------------------------------------ */
@@ -207,6 +229,10 @@ static const cyaml_strval_t field_names[] = {
     {"pressure", RHOD_FIELD_PRESSURE},         {"velocity", RHOD_FIELD_VELOCITY},
     {"density", RHOD_FIELD_DENSITY},           {"size", RHOD_FIELD_SIZE},
     {"free_surface", RHOD_FIELD_FREE_SURFACE},
+};
+static const cyaml_strval_t quantity_names[] = {
+    {"pressure", RHOD_QTY_PRESSURE},
+    {"dynamic_pressure", RHOD_QTY_DYNAMIC_PRESSURE},
 };
 static const char *const probe_kind_names[] = {
     "pressure", "kinetic_energy", "potential_energy", "front",
@@ -363,6 +389,34 @@ static const cyaml_schema_field_t f_picture[] = {
     CYAML_FIELD_END,
 };
 
+static const cyaml_schema_field_t f_region[] = {
+    SHAPE_FIELDS(y_region),
+    NUM("level", y_region, level),
+    CYAML_FIELD_END,
+};
+static const cyaml_schema_value_t sch_region = {
+    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, y_region, f_region)};
+
+static const cyaml_schema_field_t f_refine_field[] = {
+    CYAML_FIELD_ENUM("quantity", CYAML_FLAG_STRICT, y_refine_field, quantity, quantity_names,
+                     CYAML_ARRAY_LEN(quantity_names)),
+    NUM_OPT("above", y_refine_field, above),
+    NUM_OPT("below", y_refine_field, below),
+    NUM_OPT("from", y_refine_field, from),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_refinement[] = {
+    NUM_OPT("levels", y_refinement, levels),
+    CYAML_FIELD_SEQUENCE_COUNT("regions", OPT, y_refinement, regions, n_regions, &sch_region, 0,
+                               CYAML_UNLIMITED),
+    BOOL_OPT("dynamic", y_refinement, dynamic),
+    BOOL_OPT("free_surface", y_refinement, free_surface),
+    BOOL_OPT("walls", y_refinement, walls),
+    CYAML_FIELD_MAPPING_PTR("field", OPT | CYAML_FLAG_FLOW, y_refinement, field, f_refine_field),
+    CYAML_FIELD_END,
+};
+
 static const cyaml_schema_field_t f_output[] = {
     CYAML_FIELD_MAPPING_PTR("picture", OPT, y_output, picture, f_picture),
     CYAML_FIELD_END,
@@ -380,6 +434,7 @@ static const cyaml_schema_field_t f_doc[] = {
     CYAML_FIELD_SEQUENCE_COUNT("walls", OPT, y_doc, walls, n_walls, &sch_wall, 0, CYAML_UNLIMITED),
     CYAML_FIELD_MAPPING_PTR("probes", OPT, y_doc, probes, f_probes),
     CYAML_FIELD_MAPPING_PTR("output", OPT, y_doc, output, f_output),
+    CYAML_FIELD_MAPPING_PTR("refinement", OPT, y_doc, refinement, f_refinement),
     CYAML_FIELD_END,
 };
 
@@ -1170,6 +1225,55 @@ static unsigned probe_columns(const rhod_probe *p, char cols[2][NAME_MAX_LEN + 3
   return 1;
 }
 
+/* refinement: levels, initial regions and the switchable criteria of Sec. V B. */
+static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
+  char path[128];
+  const double levels = r && r->levels ? *r->levels : 1;
+  if (!(levels >= 1 && levels <= RHOD_MAX_LEVELS && levels == floor(levels)))
+    return fail(c, "refinement.levels", "must be a whole number in [1, %d], got %g",
+                RHOD_MAX_LEVELS, levels);
+  s->levels = (int)levels;
+  s->refine_dynamic = s->levels > 1 && opt_bool(r ? r->dynamic : NULL, 1);
+  s->refine_free_surface = opt_bool(r ? r->free_surface : NULL, 0);
+  s->refine_walls = opt_bool(r ? r->walls : NULL, 0);
+  if (r && r->n_regions) {
+    s->regions = calloc(r->n_regions, sizeof *s->regions);
+    if (!s->regions)
+      return fail_oom(c);
+    s->n_regions = r->n_regions;
+  }
+  for (unsigned i = 0; i < s->n_regions; i++) {
+    const y_region *y = &r->regions[i];
+    snprintf(path, sizeof path, "refinement.regions.%u", i);
+    TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &s->regions[i].shape));
+    snprintf(path, sizeof path, "refinement.regions.%u.level", i);
+    if (!(y->level >= 1 && y->level <= s->levels - 1 && y->level == floor(y->level)))
+      return fail(c, path,
+                  "must be a whole number in [1, refinement.levels - 1 = %d] (level 0 is "
+                  "particles.dx), got %g",
+                  s->levels - 1, y->level);
+    s->regions[i].level = (int)y->level;
+  }
+  const y_refine_field *f = r ? r->field : NULL;
+  if (f) {
+    if (!f->above && !f->below)
+      return fail(c, "refinement.field", "needs a threshold: above, below or both");
+    s->refine_field = 1;
+    s->field_quantity = (rhod_quantity)f->quantity;
+    s->field_above = f->above ? *f->above : HUGE_VAL;
+    s->field_below = f->below ? *f->below : -HUGE_VAL;
+    s->field_from = opt(f->from, 0);
+    if (f->above && f->below && !(s->field_below < s->field_above))
+      return fail(c, "refinement.field.below", "(%g) must be below refinement.field.above (%g)",
+                  s->field_below, s->field_above);
+  }
+  const int any = s->refine_free_surface || s->refine_walls || s->refine_field;
+  if (s->levels == 1 && (any || s->n_regions))
+    return fail(c, "refinement.levels",
+                "is 1 (single resolution): regions and criteria need at least 2 levels");
+  return RHOD_OK;
+}
+
 static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   char path[128];
   /* time */
@@ -1322,6 +1426,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     w->slip = y->slip ? (rhod_slip)*y->slip : RHOD_SLIP_FREE;
     w->fluid_inside = opt_bool(y->fluid_inside, 1);
   }
+  /* refinement (paper 002 Sec. V) */
+  TRY(load_refinement(c, d->refinement, s));
   /* the default domain: bounding box of walls and fluid */
   if (!s->has_domain) {
     for (unsigned i = 0; i < s->n_fluid + s->n_walls; i++) {
@@ -1619,6 +1725,27 @@ static ry_node *scene_tree(const rhod_scene *s) {
     if (p->kind == RHOD_PROBE_FRONT)
       tb_vec(&t, b, "direction", p->direction);
   }
+  m = tb_coll(&t, root, "refinement", RY_MAP, 0);
+  tb_num(&t, m, "levels", s->levels);
+  e = tb_coll(&t, m, "regions", RY_SEQ, s->n_regions == 0);
+  for (unsigned i = 0; i < s->n_regions; i++) {
+    ry_node *r = tb_coll(&t, e, NULL, RY_MAP, 0);
+    tb_shape(&t, r, &s->regions[i].shape);
+    tb_num(&t, r, "level", s->regions[i].level);
+  }
+  tb_bool(&t, m, "dynamic", s->refine_dynamic);
+  tb_bool(&t, m, "free_surface", s->refine_free_surface);
+  tb_bool(&t, m, "walls", s->refine_walls);
+  if (s->refine_field) {
+    e = tb_coll(&t, m, "field", RY_MAP, 1);
+    tb_word(&t, e, "quantity",
+            strval_name(quantity_names, CYAML_ARRAY_LEN(quantity_names), (int)s->field_quantity));
+    if (s->field_above != HUGE_VAL)
+      tb_num(&t, e, "above", s->field_above);
+    if (s->field_below != -HUGE_VAL)
+      tb_num(&t, e, "below", s->field_below);
+    tb_num(&t, e, "from", s->field_from);
+  }
   m = tb_coll(&t, root, "output", RY_MAP, 0);
   m = tb_coll(&t, m, "picture", RY_MAP, 0);
   tb_word(&t, m, "field",
@@ -1649,6 +1776,9 @@ void rhod_scene_free(rhod_scene *s) {
     free(s->walls[i].shape.points);
   for (unsigned i = 0; i < s->n_probes; i++)
     free(s->probes[i].name);
+  for (unsigned i = 0; i < s->n_regions; i++)
+    free(s->regions[i].shape.points);
+  free(s->regions);
   free(s->fluid);
   free(s->walls);
   free(s->probes);

@@ -91,6 +91,87 @@ static double jitter_rand(uint64_t *st) {
   return (double)(*st >> 11) / 9007199254740992.0 - 0.5;
 }
 
+/* Finest initial level asked by the refinement regions at (x, y); 0 outside all. */
+static int region_level(const rhod_scene *sc, double x, double y) {
+  int l = 0;
+  for (unsigned r = 0; r < sc->n_regions; r++)
+    if (sc->regions[r].level > l && in_shape(&sc->regions[r].shape, x, y))
+      l = sc->regions[r].level;
+  return l;
+}
+
+/* One fluid particle of size dx at (x, y) of block b, with the block's initial state,
+ * if the point is fluid (inside the block, not in an earlier block, not behind a
+ * wall). Counts it; writes it when `write`. */
+static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t *n, int write) {
+  const rhod_scene *sc = s->sc;
+  const rhod_fluid_block *B = &sc->fluid[b];
+  if (!in_shape(&B->shape, x, y))
+    return;
+  for (unsigned e = 0; e < b; e++) /* a point of an earlier block is not filled twice */
+    if (in_shape(&sc->fluid[e].shape, x, y))
+      return;
+  if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1])
+    return;
+  if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0)
+    return;
+  if (write) {
+    rhod_particles *p = &s->p;
+    const double g = hypot(sc->gravity[0], sc->gravity[1]);
+    const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
+    const double c2 = sc->c0 * sc->c0;
+    double P = 0;
+    if (B->pressure == RHOD_INIT_HYDROSTATIC) {
+      /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1) */
+      const double depth = shape_top(&B->shape, ex, ey) - (x * ex + y * ey);
+      P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
+    }
+    double u = B->velocity[0], v = B->velocity[1];
+    if (B->flow == RHOD_FLOW_TAYLOR_GREEN) {
+      const double k = 2 * M_PI / B->flow_L, U = B->flow_U;
+      u += U * sin(k * x) * cos(k * y);
+      v -= U * cos(k * x) * sin(k * y);
+      P += sc->rho0 * U * U / 4 * (cos(2 * k * x) + cos(2 * k * y));
+    } else if (B->flow == RHOD_FLOW_ROTATION) {
+      const double w = B->flow_omega;
+      u -= w * (y - B->flow_center[1]);
+      v += w * (x - B->flow_center[0]);
+      P += rotation_pressure(sc->rho0, w, B->shape.max[0] - B->shape.min[0],
+                             B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
+                             y - B->shape.min[1]);
+    }
+    const double rho = sc->rho0 + P / c2; /* Eq. 2 */
+    const size_t k = *n;
+    p->x[k] = (real)x;
+    p->y[k] = (real)y;
+    p->ux[k] = (real)u;
+    p->uy[k] = (real)v;
+    p->rho[k] = (real)rho;
+    p->m[k] = (real)(rho * dx * dx); /* m_i = rho_i(0) V_i(0) */
+    p->dx[k] = (real)dx;
+    p->id[k] = k;
+  }
+  (*n)++;
+}
+
+/* The lattice cell of size f dx0 (f = 2^-l at level l) centred at lo + (ci, cj) dx0:
+ * one particle (jittered by (jx, jy) of its size), or, where a refinement region asks
+ * for a finer level at its centre, its four quarter cells, each refined again where
+ * asked. This nests the levels as a quadtree: the recipe of paper 002 Sec. VI C
+ * (Fig. 14) once the regions are at least 8 dx of their level apart. */
+static void fill_cell(rhod_sim *s, unsigned b, const double lo[2], double dx0, double ci, double cj,
+                      double f, int l, double jx, double jy, uint64_t *rs, size_t *n, int write) {
+  if (region_level(s->sc, lo[0] + ci * dx0, lo[1] + cj * dx0) <= l) {
+    emit(s, b, lo[0] + (ci + jx * f) * dx0, lo[1] + (cj + jy * f) * dx0, f * dx0, n, write);
+    return;
+  }
+  for (int q = 0; q < 4; q++) {
+    const double j2x = s->sc->jitter * jitter_rand(rs), j2y = s->sc->jitter * jitter_rand(rs);
+    fill_cell(s, b, lo, dx0, ci + ((q & 1) ? 0.25 : -0.25) * f, cj + ((q & 2) ? 0.25 : -0.25) * f,
+              0.5 * f, l + 1, j2x, j2y, rs, n, write);
+  }
+}
+
 static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
   const rhod_scene *sc = s->sc;
   const double dx = sc->dx;
@@ -105,10 +186,6 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
       shape_box(&B->shape, lo, hi);
       const long nx = (long)floor((hi[0] - lo[0]) / dx + 1e-9);
       const long ny = (long)floor((hi[1] - lo[1]) / dx + 1e-9);
-      const double g = hypot(sc->gravity[0], sc->gravity[1]);
-      const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
-      const double top = shape_top(&B->shape, ex, ey);
-      const double c2 = sc->c0 * sc->c0;
       for (long j = 0; j < ny; j++)
         for (long i = 0; i < nx; i++) {
           /* particles.jitter breaks the symmetry of the lattice, which otherwise
@@ -116,51 +193,7 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
            * concentration) cannot act, until it collapses (seen on the Taylor-Green
            * vortex) */
           const double jx = sc->jitter * jitter_rand(&rs), jy = sc->jitter * jitter_rand(&rs);
-          const double x = lo[0] + (i + 0.5 + jx) * dx, y = lo[1] + (j + 0.5 + jy) * dx;
-          if (!in_shape(&B->shape, x, y))
-            continue;
-          int taken = 0; /* a point of an earlier block is not filled twice */
-          for (unsigned e = 0; e < b && !taken; e++)
-            taken = in_shape(&sc->fluid[e].shape, x, y);
-          if (taken)
-            continue;
-          if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1])
-            continue;
-          if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0)
-            continue;
-          if (pass == 1) {
-            rhod_particles *p = &s->p;
-            double P = 0;
-            if (B->pressure == RHOD_INIT_HYDROSTATIC) {
-              /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1) */
-              const double depth = top - (x * ex + y * ey);
-              P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
-            }
-            double u = B->velocity[0], v = B->velocity[1];
-            if (B->flow == RHOD_FLOW_TAYLOR_GREEN) {
-              const double k = 2 * M_PI / B->flow_L, U = B->flow_U;
-              u += U * sin(k * x) * cos(k * y);
-              v -= U * cos(k * x) * sin(k * y);
-              P += sc->rho0 * U * U / 4 * (cos(2 * k * x) + cos(2 * k * y));
-            } else if (B->flow == RHOD_FLOW_ROTATION) {
-              const double w = B->flow_omega;
-              u -= w * (y - B->flow_center[1]);
-              v += w * (x - B->flow_center[0]);
-              P += rotation_pressure(sc->rho0, w, B->shape.max[0] - B->shape.min[0],
-                                     B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
-                                     y - B->shape.min[1]);
-            }
-            const double rho = sc->rho0 + P / c2; /* Eq. 2 */
-            p->x[n] = (real)x;
-            p->y[n] = (real)y;
-            p->ux[n] = (real)u;
-            p->uy[n] = (real)v;
-            p->rho[n] = (real)rho;
-            p->m[n] = (real)(rho * dx * dx); /* m_i = rho_i(0) V_i(0) */
-            p->dx[n] = (real)dx;
-            p->id[n] = n;
-          }
-          n++;
+          fill_cell(s, b, lo, dx, i + 0.5, j + 0.5, 1.0, 0, jx, jy, &rs, &n, pass);
         }
     }
     if (pass == 0) {
@@ -205,7 +238,13 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
         s->lo[a] = fmin(s->lo[a], lo[a]), s->hi[a] = fmax(s->hi[a], hi[a]);
     }
   }
-  s->margin = sc->radius_ratio * sc->dx;
+  s->margin = sc->radius_ratio * sc->dx; /* particles.dx is the coarsest size (level 0) */
+  s->dx_min = ldexp(sc->dx, -(sc->levels - 1));
+  /* Wall mirrors: a fluid particle's ghost is needed by every particle whose support
+   * crosses the wall. With one size that is within R_i of the wall; with mixed sizes
+   * a neighbour may be up to twice as large (criterion 1 keeps sizes in a support
+   * within a factor 2), so mirrors reach 2 R_i. */
+  s->mirror_ratio = sc->radius_ratio * (sc->levels > 1 ? 2 : 1);
   int st = rhod_particles_init(&s->p, 1024);
   if (st == RHOD_OK)
     st = rhod_boundary_init(&s->bnd, sc, s->lo, s->hi);
@@ -242,16 +281,45 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
       rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
   const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
   const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
-  st = rhod_cells_init(&s->cells, glo, ghi, s->margin, RHOD_CELL_REACH, p->cap);
+  /* one grid made for the finest radius; coarser particles scan more cells (cells.h) */
+  st = rhod_cells_init(&s->cells, glo, ghi, sc->radius_ratio * s->dx_min, RHOD_CELL_REACH, p->cap);
   if (st != RHOD_OK) {
-    snprintf(err, errlen, "%s: domain: too many cells for particles.dx = %g", sc->path, sc->dx);
+    snprintf(err, errlen, "%s: domain: too many cells for a finest size of %g m", sc->path,
+             s->dx_min);
     return st;
   }
+  st = rhod_apr_init(&s->apr, sc, s->dx_min);
+  if (st != RHOD_OK)
+    return st;
   s->dt = rhod_sph_dt(&s->sph, p);
-  return rhod_sim_prepare(s, 1);
+  st = rhod_sim_prepare(s, 1);
+  if (st != RHOD_OK || !s->apr.active)
+    return st;
+  /* The initial lattice is refined by the criteria before the first step, until none
+   * asks for more (at most levels - 1 rounds), so the run starts from a layout that
+   * satisfies them (paper 002 Sec. V B: "the initial particle setup is chosen to
+   * naturally ensure the criteria") instead of splitting in cascade once it moves. */
+  for (int round = 1; round < sc->levels; round++) {
+    rhod_sph_rhs(&s->sph, p, &s->cells, (real)s->dt);
+    st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, 0);
+    const long split = st == RHOD_OK ? rhod_apr_split(&s->apr, &s->sph, p) : -1;
+    if (split < 0) {
+      snprintf(err, errlen, "out of memory refining the initial particles");
+      return RHOD_ERR_MEMORY;
+    }
+    if (split == 0)
+      break;
+    s->dt = rhod_sph_dt(&s->sph, p);
+    st = rhod_sim_prepare(s, 1);
+    if (st != RHOD_OK)
+      return st;
+  }
+  s->apr.split_total = 0;
+  return RHOD_OK;
 }
 
 void rhod_sim_free(rhod_sim *s) {
+  rhod_apr_free(&s->apr);
   rhod_cells_free(&s->cells);
   rhod_boundary_free(&s->bnd);
   rhod_particles_free(&s->p);
@@ -301,7 +369,7 @@ int rhod_sim_prepare(rhod_sim *s, int sort) {
       perm[k] = idx[k];
     rhod_particles_permute(p);
   }
-  int st = rhod_ghosts_build(&s->bnd, p, (real)s->sc->radius_ratio, (real)s->margin);
+  int st = rhod_ghosts_build(&s->bnd, p, (real)s->mirror_ratio, (real)s->margin);
   if (st != RHOD_OK)
     return st;
   if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK)
@@ -374,15 +442,31 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
         goto mem;
     }
     rhod_sph_rhs(&s->sph, p, &s->cells, (real)dt);
+    /* refinement criteria during the last stage (paper 002 Sec. V) */
+    if (s->apr.active && stage == s->rk.stages - 1) {
+      st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, s->t + dt);
+      if (st != RHOD_OK)
+        goto mem;
+    }
     rhod_rk_stage(&s->rk, p, stage, (real)dt);
   }
   s->neighbours_fresh = 0;
   s->reflected += rhod_walls_guard(&s->bnd, p);
   s->t += dt;
   s->step++;
-  return check_state(s, err, errlen);
+  st = check_state(s, err, errlen);
+  if (st != RHOD_OK || !s->apr.active)
+    return st;
+  /* the marked particles split before the next step, which sorts them in */
+  if (rhod_apr_split(&s->apr, &s->sph, p) < 0) {
+    st = RHOD_ERR_MEMORY;
+    goto mem;
+  }
+  if (s->apr.split_last > 0)
+    s->dt = rhod_sph_dt(&s->sph, p);
+  return RHOD_OK;
 mem:
-  snprintf(err, errlen, "out of memory for the ghost particles at t = %g s", s->t);
+  snprintf(err, errlen, "out of memory for %zu particles at t = %g s", p->n, s->t);
   return st;
 }
 
@@ -412,7 +496,7 @@ void rhod_probe_values(rhod_sim *s, double *values) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *m = p->m, *P = h->P, *V = h->V;
   const int kern = h->kernel;
-  const real R = (real)(sc->radius_ratio * sc->dx);
+  const real *dx = p->dx, ratio = h->ratio;
   const real gx = h->gx, gy = h->gy;
   unsigned k = 0;
   for (unsigned i = 0; i < sc->n_probes; i++) {
@@ -422,12 +506,13 @@ void rhod_probe_values(rhod_sim *s, double *values) {
     switch (pr->kind) {
     case RHOD_PROBE_PRESSURE: {
       /* Shepard interpolation over fluid and ghosts; 0 where the support is dry
-       * (Gamma < 0.1) */
+       * (Gamma < 0.1). A point has no size of its own: each particle contributes
+       * with its own radius R_j (our choice; one size gives the usual sum). */
       real num = 0, den = 0;
       RHOD_KERNEL_LOOP_REDUCE2(+, num, den)
       for (long j = 0; j < nt; j++) {
         const real rx = x[j] - ax, ry = y[j] - ay;
-        const real w = rhod_W(kern, sqrt(rx * rx + ry * ry), R) * V[j];
+        const real w = rhod_W(kern, sqrt(rx * rx + ry * ry), ratio * dx[j]) * V[j];
         num += w * P[j];
         den += w;
       }

@@ -131,7 +131,7 @@ static void test_neighbours_brute_force(void) {
     long mism = 0, total = 0;
     for (size_t i = 0; i < p->n; i++) {
       int found = 0, brute = 0;
-      RHOD_FOR_NEIGHBOURS(G, CS, CI, p->x[i], p->y[i], j) {
+      RHOD_FOR_NEIGHBOURS(G, CS, CI, p->x[i], p->y[i], R, j) {
         const real rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i];
         if (rx * rx + ry * ry < R * R)
           found++;

@@ -38,6 +38,11 @@ void rhod_boundary_free(rhod_boundary *b);
  * Copies x, y, m, dx into the ghosts and sets gsrc, gJ, gT, ge. */
 int rhod_ghosts_build(rhod_boundary *b, rhod_particles *p, real radius_ratio, real margin);
 
+/* near[i] = 1 when the support of fluid particle i (radius radius_ratio * dx_i)
+ * reaches a wall, else 0 (refinement criterion 4 of paper 002 Sec. V B). */
+void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real radius_ratio,
+                     uint8_t *near);
+
 /* Reflects fluid particles that ended a step just behind a wall (see ghosts.c);
  * returns how many. */
 long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p);

@@ -1,16 +1,21 @@
 /* Sorted cell lists by counting sort, and the one neighbour loop every gather uses.
  *
- * The grid covers a box with square cells of side >= R/reach, R the largest kernel
- * radius, so the (2 reach + 1)^2 block of cells around a particle holds its whole
- * support (reach 2 scans 6.25 R^2 instead of the 9 R^2 of reach 1). Order inside a
- * cell is by particle index, so every sum is taken in the same order run after run
- * (bit-reproducible). A per-refinement-level grid is a set of these with their own
- * cell size (APR). */
+ * The grid covers a box with square cells of side >= R0/reach, R0 the kernel radius
+ * of the finest particles, so the (2 reach + 1)^2 block of cells around a particle of
+ * radius R0 holds its whole support (reach 2 scans 6.25 R^2 instead of the 9 R^2 of
+ * reach 1). Mixed sizes (APR, paper 002 Sec. IV D): a particle of radius R_i scans
+ * reach * ceil(R_i / R0) cells on each side of its own, so one grid serves every
+ * level. A row of cells is one contiguous range of the sorted index, so the cost of
+ * a wider scan is one range per row plus the particles in it (perf/bench_passes
+ * compares this with a grid made for the coarsest radius). Order inside a cell is by
+ * particle index, so every sum is taken in the same order run after run
+ * (bit-reproducible). */
 #ifndef RHOD_CELLS_H
 #define RHOD_CELLS_H
 
 #include "rhod/config.h"
 #include "rhod/particles.h"
+#include <math.h>
 
 /* Cells scanned on each side by the solver (chosen by perf/bench_passes). */
 #ifndef RHOD_CELL_REACH
@@ -22,7 +27,8 @@ typedef struct {
   real ox, oy; /* lower-left corner */
   real inv;    /* 1 / cell */
   int nx, ny;
-  int reach; /* cells scanned on each side */
+  int reach; /* cells scanned on each side by a particle of radius R0 */
+  real iR0;  /* 1 / R0 */
 } rhod_grid;
 
 typedef struct {
@@ -36,8 +42,8 @@ typedef struct {
   size_t cap;
 } rhod_cells;
 
-/* Sets up a grid over [lo, hi] for kernel radii up to `radius`, with cells of side
- * >= radius / reach. */
+/* Sets up a grid over [lo, hi] for kernel radii of at least `radius` (R0), with cells
+ * of side >= radius / reach. */
 int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double radius, int reach,
                     size_t cap);
 int rhod_cells_reserve(rhod_cells *c, size_t cap);
@@ -57,22 +63,34 @@ static inline int rhod_cell_coord(real v, real o, real inv, int n) {
   return k < 0 ? 0 : (k >= n ? n - 1 : k);
 }
 
+/* Cells scanned on each side for a support of radius R: reach * k with k = R/R0
+ * rounded up. Sizes are dx_min 2^l, so R/R0 is a power of two up to rounding; the
+ * 1e-4 keeps a rounding excess from adding a ring of cells (at worst it leaves out
+ * the outer 1e-4 of a cell, where every kernel is 0 to 16 digits). Equal sizes give
+ * k = 1: the scan of single resolution, bit for bit. */
+static inline int rhod_cell_reach(rhod_grid G, real R) {
+  const int k = (int)ceil(R * G.iR0 - (real)1e-4);
+  return G.reach * (k > 1 ? k : 1);
+}
+
 /* The gather loop. Inside a device region only plain locals may be used, so the
  * caller copies the arrays to locals first:
  *
  *   const rhod_grid G = cells->g; const int32_t *CS = cells->start, *CI = cells->idx;
- *   RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j) { ... uses j ... } RHOD_END_NEIGHBOURS
+ *   RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) { ... uses j ... } RHOD_END_NEIGHBOURS
  *
  * j runs over every particle (fluid and ghost, i itself included) in the cells
- * around (xi, yi); the body tests the distance against its own radius. */
-#define RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, j)                                                  \
+ * around (xi, yi) that can lie within Ri (the gathering particle's radius); the body
+ * tests the distance against it. */
+#define RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j)                                              \
   {                                                                                                \
+    const int rc_ = rhod_cell_reach((G), (Ri));                                                    \
     const int cx_ = rhod_cell_coord((xi), (G).ox, (G).inv, (G).nx);                                \
     const int cy_ = rhod_cell_coord((yi), (G).oy, (G).inv, (G).ny);                                \
-    const int y0_ = cy_ - (G).reach > 0 ? cy_ - (G).reach : 0;                                     \
-    const int y1_ = cy_ + (G).reach < (G).ny - 1 ? cy_ + (G).reach : (G).ny - 1;                   \
-    const int x0_ = cx_ - (G).reach > 0 ? cx_ - (G).reach : 0;                                     \
-    const int x1_ = cx_ + (G).reach < (G).nx - 1 ? cx_ + (G).reach : (G).nx - 1;                   \
+    const int y0_ = cy_ - rc_ > 0 ? cy_ - rc_ : 0;                                                 \
+    const int y1_ = cy_ + rc_ < (G).ny - 1 ? cy_ + rc_ : (G).ny - 1;                               \
+    const int x0_ = cx_ - rc_ > 0 ? cx_ - rc_ : 0;                                                 \
+    const int x1_ = cx_ + rc_ < (G).nx - 1 ? cx_ + rc_ : (G).nx - 1;                               \
     for (int yy_ = y0_; yy_ <= y1_; yy_++) {                                                       \
       const int k0_ = (CS)[yy_ * (G).nx + x0_], k1_ = (CS)[yy_ * (G).nx + x1_ + 1];                \
       for (int k_ = k0_; k_ < k1_; k_++) {                                                         \
@@ -82,14 +100,15 @@ static inline int rhod_cell_coord(real v, real o, real inv, int n) {
   }                                                                                                \
   }
 
-/* 1 when a cell in reach of (x, y) is marked (inside device regions: pass a local
- * copy of c->mark). */
-static inline int rhod_cells_near_mark(rhod_grid G, const uint8_t *mark, real x, real y) {
+/* 1 when a cell within reach of a support of radius R at (x, y) is marked (inside
+ * device regions: pass a local copy of c->mark). */
+static inline int rhod_cells_near_mark(rhod_grid G, const uint8_t *mark, real x, real y, real R) {
+  const int rc = rhod_cell_reach(G, R);
   const int cx = rhod_cell_coord(x, G.ox, G.inv, G.nx), cy = rhod_cell_coord(y, G.oy, G.inv, G.ny);
-  const int y0 = cy - G.reach > 0 ? cy - G.reach : 0;
-  const int y1 = cy + G.reach < G.ny - 1 ? cy + G.reach : G.ny - 1;
-  const int x0 = cx - G.reach > 0 ? cx - G.reach : 0;
-  const int x1 = cx + G.reach < G.nx - 1 ? cx + G.reach : G.nx - 1;
+  const int y0 = cy - rc > 0 ? cy - rc : 0;
+  const int y1 = cy + rc < G.ny - 1 ? cy + rc : G.ny - 1;
+  const int x0 = cx - rc > 0 ? cx - rc : 0;
+  const int x1 = cx + rc < G.nx - 1 ? cx + rc : G.nx - 1;
   for (int yy = y0; yy <= y1; yy++)
     for (int xx = x0; xx <= x1; xx++)
       if (mark[yy * G.nx + xx])

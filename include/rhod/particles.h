@@ -53,4 +53,8 @@ void rhod_particles_free(rhod_particles *p);
 /* Reorders the persistent arrays of the fluid: new[k] = old[perm[k]], k < n.
  * perm lives on the device (p->perm). */
 void rhod_particles_permute(rhod_particles *p);
+/* Appends `count` fluid particles, copies of src[k] (< n, on the device) in every
+ * persistent array, at [n, n + count); the caller has reserved room and fixes what
+ * differs (refinement children). Ghosts are dropped (p->ng = 0). */
+void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count);
 #endif

@@ -98,6 +98,19 @@ typedef enum {
   RHOD_FIELD_FREE_SURFACE
 } rhod_field;
 
+/* Most particle sizes a scene may use: dx, dx/2, ..., dx/2^(RHOD_MAX_LEVELS-1). */
+#define RHOD_MAX_LEVELS 8
+
+/* An initial refinement region: the lattice inside it starts at `level` (size
+ * particles.dx / 2^level), the finest region containing a point winning. */
+typedef struct {
+  rhod_shape shape;
+  int level;
+} rhod_region;
+
+/* The field of refinement criterion 5 (paper 002 Sec. V B), Shepard-averaged. */
+typedef enum { RHOD_QTY_PRESSURE = 0, RHOD_QTY_DYNAMIC_PRESSURE } rhod_quantity;
+
 typedef struct {
   /* time: */
   double t_end;                    /* time.end [s] (required) */
@@ -141,6 +154,18 @@ typedef struct {
   rhod_probe *probes;
   unsigned n_probes;
   double probe_every; /* probes.every [s]: sampling interval, default output_every/10 */
+  /* refinement (adaptive particle refinement, paper 002 Secs. IV D and V): */
+  int levels;           /* refinement.levels: sizes dx ... dx/2^(levels-1), default 1 */
+  rhod_region *regions; /* refinement.regions: initial nested levels */
+  unsigned n_regions;
+  int refine_dynamic;              /* refinement.dynamic: split by the criteria during the run
+                                      (criteria 1 and 2 always), default true when levels > 1 */
+  int refine_free_surface;         /* refinement.free_surface: criterion 3, default false */
+  int refine_walls;                /* refinement.walls: criterion 4, default false */
+  int refine_field;                /* refinement.field given: criterion 5 */
+  rhod_quantity field_quantity;    /* refinement.field.quantity */
+  double field_above, field_below; /* thresholds (+-HUGE_VAL when absent) */
+  double field_from;               /* refinement.field.from [s], default 0 */
   /* output: */
   rhod_field picture_field; /* output.picture.field, default pressure */
   unsigned picture_width;   /* output.picture.width [pixels], default 800 */

@@ -3,6 +3,7 @@
 #ifndef RHOD_SIM_H
 #define RHOD_SIM_H
 
+#include "rhod/apr.h"
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/integrator.h"
@@ -18,8 +19,11 @@ typedef struct {
   rhod_cells cells;
   rhod_sph sph;
   rhod_rk rk;
+  rhod_apr apr;
   double lo[2], hi[2]; /* domain box */
   double margin;       /* ghost layer width: largest kernel radius */
+  double dx_min;       /* finest particle size the scene allows */
+  double mirror_ratio; /* wall mirrors within mirror_ratio * dx_i of a wall */
   double t, dt;
   long step;
   long reflected;       /* particles put back by the wall-crossing guard, whole run */
