@@ -54,7 +54,12 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     const real x1 = x - 2 * da * A[2], y1 = y - 2 * da * A[3];
     const real db = B[2] * (x1 - B[0]) + B[3] * (y1 - B[1]);
     const real x2 = x1 - 2 * db * B[2], y2 = y1 - 2 * db * B[3];
-    if ((x2 - x) * (x2 - x) + (y2 - y) * (y2 - y) >= R * R)
+    /* the corner ghost lies 2 rho from its source (rho the distance to the corner)
+     * and at least rho from any particle on the fluid side: it is needed when
+     * rho < R, i.e. closer than 2R to its source (it was R until 2026-11-22, which
+     * left out the corner ghosts of particles between R/2 and R from the corner:
+     * Gamma = 0.995 at a corner particle instead of 1.001; found by test_apr) */
+    if ((x2 - x) * (x2 - x) + (y2 - y) * (y2 - y) >= 4 * R * R)
       continue;
     if (gx) {
       gx[n] = x2;

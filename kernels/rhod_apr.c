@@ -104,10 +104,39 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     const int m = grand || same < 2 * self || (c3 && reg[i] != 0) || (c4 && near[i]) ||
                   (c5 && (phi > above || phi < below));
     mark[i] = (uint8_t)m;
-    if (best < R2) {
-      const real e = sqrt(best);
-      sd[4 * i + 2] = ex / e, sd[4 * i + 3] = ey / e;
+    if (!m || !(best < R2))
+      continue;
+    /* Orientation of the children's square (Sec. V A, Fig. 5): the paper aligns it
+     * with the direction to the nearest neighbour "to maximize the minimum
+     * inter-particle distance once the refinement is completed". Our choice: that
+     * direction and five more turned by 15, 30, ... 75 degrees (the square repeats
+     * every 90) are tried, and the one whose four children stay farthest from every
+     * neighbour within 1.5 dx_i wins; ties keep the nearest-neighbour alignment. */
+    const real e0 = sqrt(best), cx = ex / e0, cy = ey / e0, h = (real)0.25 * dxi;
+    const real near2 = (real)2.25 * dxi * dxi;
+    real dk[6];
+    for (int k = 0; k < 6; k++)
+      dk[k] = near2;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi;
+      if (j != i && rx * rx + ry * ry < near2)
+        for (int k = 0; k < 6; k++) {
+          const real th = (real)(RHOD_PI / 12) * k, ct = cos(th), st = sin(th);
+          const real fx = ct * cx - st * cy, fy = st * cx + ct * cy; /* e turned by th */
+          for (int q = 0; q < 4; q++) {
+            const real sa = (q & 1) ? h : -h, sb = (q & 2) ? h : -h;
+            const real qx = rx - (sa * fx - sb * fy), qy = ry - (sa * fy + sb * fx);
+            const real d2 = qx * qx + qy * qy;
+            dk[k] = d2 < dk[k] ? d2 : dk[k];
+          }
+        }
     }
+    RHOD_END_NEIGHBOURS
+    int kb = 0;
+    for (int k = 1; k < 6; k++)
+      kb = dk[k] > dk[kb] ? k : kb;
+    const real th = (real)(RHOD_PI / 12) * kb, ct = cos(th), st = sin(th);
+    sd[4 * i + 2] = ct * cx - st * cy, sd[4 * i + 3] = st * cx + ct * cy;
   }
   return RHOD_OK;
 }

@@ -191,7 +191,7 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
   rhod_sim *s = &c->sim;
   char buf[16384];
   size_t o = 0;
-  const double psteps = (double)s->p.n * (double)(s->step - c->step0);
+  const double psteps = s->particle_steps;
   o += (size_t)snprintf(buf + o, sizeof buf - o,
                         "{\n  \"status\": \"%s\",\n  \"cause\": \"%s\",\n  \"scene\": \"%s\",\n"
                         "  \"particles\": %zu,\n  \"steps\": %ld,\n  \"time\": %.9g,\n"
@@ -337,6 +337,7 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       c.sim.t = ck.t;
       c.sim.step = ck.step;
       c.sim.reflected = ck.reflected;
+      c.sim.dt = rhod_sph_dt(&c.sim.sph, &c.sim.p); /* sizes may have been split since t = 0 */
       st = rhod_sim_prepare(&c.sim, 1);
       if (st != RHOD_OK)
         snprintf(err, sizeof err, "out of memory for ghost particles");
@@ -373,8 +374,13 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     logline("rhod: resumed from %s/checkpoint.rhod at t = %.9g s (step %ld)", out, s->t, s->step);
   logline("rhod: scene %s -> %s", c.sc->path, out);
   logline("rhod: kernels run on: %s", c.where);
-  logline("rhod: %zu fluid particles, dx = %g m, R = %g m, dt = %.4g s, %s precision", s->p.n,
-          c.sc->dx, c.sc->dx * c.sc->radius_ratio, s->dt, RHOD_REAL_NAME);
+  if (c.sc->levels > 1)
+    logline("rhod: %zu fluid particles, sizes %g m down to %g m (%d levels), R = %g dx, dt = %.4g "
+            "s, %s precision",
+            s->p.n, c.sc->dx, s->dx_min, c.sc->levels, c.sc->radius_ratio, s->dt, RHOD_REAL_NAME);
+  else
+    logline("rhod: %zu fluid particles, dx = %g m, R = %g m, dt = %.4g s, %s precision", s->p.n,
+            c.sc->dx, c.sc->dx * c.sc->radius_ratio, s->dt, RHOD_REAL_NAME);
   if (nw > 0) {
     char *line = strtok(warn, "\n");
     while (line) {
@@ -473,10 +479,10 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       last_decile = (int)(frac * 10);
       char eta[32];
       fmt_hms(frac > 0 ? w * (1 - frac) / frac : 0, eta, sizeof eta);
-      fprintf(
-          stderr, "%st = %.5g s  %5.1f%%  N = %zu  dt = %.3g s  %.3g particle-steps/s  ETA %s%s",
-          tty ? "\r" : "", s->t, 100 * frac, s->p.n, s->dt,
-          (double)s->p.n * (double)(s->step - c.step0) / (w > 0 ? w : 1), eta, tty ? "   " : "\n");
+      fprintf(stderr,
+              "%st = %.5g s  %5.1f%%  N = %zu  dt = %.3g s  %.3g particle-steps/s  ETA %s%s",
+              tty ? "\r" : "", s->t, 100 * frac, s->p.n, s->dt, s->particle_steps / (w > 0 ? w : 1),
+              eta, tty ? "   " : "\n");
       fflush(stderr);
     }
   }
@@ -484,9 +490,12 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     fprintf(stderr, "\n");
   {
     const double wall = now() - t0;
-    const double psteps = (double)s->p.n * (double)(s->step - c.step0);
+    const double psteps = s->particle_steps;
     logline("rhod: done: %ld steps, %.3f s wall, %.4g us per particle-step", s->step, wall,
             psteps > 0 ? 1e6 * wall / psteps : 0.0);
+    if (s->apr.split_total)
+      logline("rhod: %ld particles split by the refinement criteria during the run (%zu now)",
+              s->apr.split_total, s->p.n);
     if (s->reflected)
       logline("rhod: %ld particle-steps ended just behind a wall and were reflected back "
               "(docs/choices.md)",

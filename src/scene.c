@@ -1267,6 +1267,9 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
       return fail(c, "refinement.field.below", "(%g) must be below refinement.field.above (%g)",
                   s->field_below, s->field_above);
   }
+  if (s->refine_free_surface && !s->free_surface)
+    return fail(c, "refinement.free_surface",
+                "criterion 3 needs the free-surface detection (scheme.free_surface: true)");
   const int any = s->refine_free_surface || s->refine_walls || s->refine_field;
   if (s->levels == 1 && (any || s->n_regions))
     return fail(c, "refinement.levels",

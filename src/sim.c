@@ -454,6 +454,7 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   s->reflected += rhod_walls_guard(&s->bnd, p);
   s->t += dt;
   s->step++;
+  s->particle_steps += (double)p->n;
   st = check_state(s, err, errlen);
   if (st != RHOD_OK || !s->apr.active)
     return st;

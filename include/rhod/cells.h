@@ -66,8 +66,10 @@ static inline int rhod_cell_coord(real v, real o, real inv, int n) {
 /* Cells scanned on each side for a support of radius R: reach * k with k = R/R0
  * rounded up. Sizes are dx_min 2^l, so R/R0 is a power of two up to rounding; the
  * 1e-4 keeps a rounding excess from adding a ring of cells (at worst it leaves out
- * the outer 1e-4 of a cell, where every kernel is 0 to 16 digits). Equal sizes give
- * k = 1: the scan of single resolution, bit for bit. */
+ * the outer 1e-4 of a cell, where every kernel is 0 to 16 digits). In single
+ * resolution (every size = dx_min) k = 1: the same scan as before APR, bit for bit;
+ * with levels > 1 a particle coarser than dx_min scans more cells of a finer grid,
+ * which finds the same neighbours in another order (round-off differences). */
 static inline int rhod_cell_reach(rhod_grid G, real R) {
   const int k = (int)ceil(R * G.iR0 - (real)1e-4);
   return G.reach * (k > 1 ? k : 1);

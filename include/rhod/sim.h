@@ -26,8 +26,9 @@ typedef struct {
   double mirror_ratio; /* wall mirrors within mirror_ratio * dx_i of a wall */
   double t, dt;
   long step;
-  long reflected;       /* particles put back by the wall-crossing guard, whole run */
-  int neighbours_fresh; /* ghosts and cells match the current state */
+  double particle_steps; /* sum over the steps run by this process of the particle count */
+  long reflected;        /* particles put back by the wall-crossing guard, whole run */
+  int neighbours_fresh;  /* ghosts and cells match the current state */
 } rhod_sim;
 
 /* Fills the fluid from the scene (square lattice of spacing dx, initial pressure) and
