@@ -114,74 +114,63 @@ void rhod_particles_free(rhod_particles *p) {
   memset(p, 0, sizeof *p);
 }
 
+/* dst[d0 + k] = src[idx[k]] for k < count, elements of `elem` bytes (dst may be src
+ * when no dst slot is an idx source). The offset stays inside the loops: inside a
+ * device region only mapped base pointers are translated. */
+static void gather_bytes(void *dst, size_t dst0, const void *src, const int32_t *idx, size_t count,
+                         size_t elem) {
+  const long nn = (long)count, d0 = (long)dst0;
+  if (elem == 8) {
+    uint64_t *d = dst;
+    const uint64_t *a = src;
+    RHOD_KERNEL_LOOP
+    for (long k = 0; k < nn; k++)
+      d[d0 + k] = a[idx[k]];
+    return;
+  }
+  if (elem == 4) {
+    uint32_t *d = dst;
+    const uint32_t *a = src;
+    RHOD_KERNEL_LOOP
+    for (long k = 0; k < nn; k++)
+      d[d0 + k] = a[idx[k]];
+    return;
+  }
+  char *d = dst;
+  const char *a = src;
+  const long el = (long)elem;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nn; k++)
+    for (long b = 0; b < el; b++)
+      d[el * (d0 + k) + b] = a[el * (long)idx[k] + b];
+}
+
 /* Gathers one array through perm into scratch and copies it back. Sorting happens
  * once per step, so the extra copy is cheap next to the neighbour passes, and every
  * array keeps its own (mapped) buffer. */
 static void permute_bytes(void *arr, void *scratch, const int32_t *perm, size_t n, size_t elem) {
-  const long nn = (long)n;
-  if (elem == 8) {
-    uint64_t *a = arr, *d = scratch;
+  gather_bytes(scratch, 0, arr, perm, n, elem);
+  const long words = (long)(n * elem / 4), bytes = (long)(n * elem);
+  if (elem % 4 == 0) {
+    uint32_t *a = arr;
+    const uint32_t *d = scratch;
     RHOD_KERNEL_LOOP
-    for (long k = 0; k < nn; k++)
-      d[k] = a[perm[k]];
-    RHOD_KERNEL_LOOP
-    for (long k = 0; k < nn; k++)
-      a[k] = d[k];
+    for (long b = 0; b < words; b++)
+      a[b] = d[b];
     return;
   }
-  if (elem == 4) {
-    uint32_t *a = arr, *d = scratch;
-    RHOD_KERNEL_LOOP
-    for (long k = 0; k < nn; k++)
-      d[k] = a[perm[k]];
-    RHOD_KERNEL_LOOP
-    for (long k = 0; k < nn; k++)
-      a[k] = d[k];
-    return;
-  }
-  char *dst = scratch;
   char *a = arr;
-  const long el = (long)elem;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nn; k++)
-    for (long b = 0; b < el; b++)
-      dst[el * k + b] = a[el * (long)perm[k] + b];
-  const long bytes = nn * el;
+  const char *d = scratch;
   RHOD_KERNEL_LOOP
   for (long b = 0; b < bytes; b++)
-    a[b] = dst[b];
-}
-
-/* dst[k] = a[src[k]] for k < count, one element of `elem` bytes each. */
-static void copy_from(void *arr, size_t dst0, const int32_t *src, size_t count, size_t elem) {
-  const long nn = (long)count, d0 = (long)dst0;
-  if (elem == 8) {
-    uint64_t *a = arr;
-    RHOD_KERNEL_LOOP
-    for (long k = 0; k < nn; k++)
-      a[d0 + k] = a[src[k]];
-    return;
-  }
-  if (elem == 4) {
-    uint32_t *a = arr;
-    RHOD_KERNEL_LOOP
-    for (long k = 0; k < nn; k++)
-      a[d0 + k] = a[src[k]];
-    return;
-  }
-  char *a = arr;
-  const long el = (long)elem;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nn; k++)
-    for (long b = 0; b < el; b++)
-      a[el * (d0 + k) + b] = a[el * (long)src[k] + b];
+    a[b] = d[b];
 }
 
 void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count) {
   for (int i = 0; i < p->nfields; i++) {
     rhod_field_desc *f = &p->fields[i];
     if (f->persistent)
-      copy_from(*f->ptr, p->n, src, count, f->elem);
+      gather_bytes(*f->ptr, p->n, *f->ptr, src, count, f->elem);
   }
   p->n += count;
   p->ng = 0;

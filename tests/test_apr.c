@@ -11,6 +11,7 @@
 #include "rhod/device.h"
 #include "rhod/sim.h"
 #include "rhod/sph.h"
+#include "test_scene_util.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,20 +28,6 @@ static double rnd(unsigned long *s) {
 
 /* ------------------------------------------------------------------------------------ */
 /* hand-made particle clouds                                                             */
-
-/* A minimal scene for the scheme's parameters (no refinement criterion switched on). */
-static rhod_scene *unit_scene(double dx) {
-  rhod_scene *sc = calloc(1, sizeof *sc);
-  sc->t_end = 1, sc->output_every = 1, sc->cfl = 0.5, sc->cfl_visc = 0.025;
-  sc->dx = dx, sc->radius_ratio = 4, sc->kernel = RHOD_KERNEL_WENDLAND_C2;
-  sc->rho0 = 1000, sc->c0 = 20, sc->mu = 0;
-  sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = sc->free_surface = 1;
-  sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
-  sc->fs_lambda_low = 0.2, sc->fs_lambda_high = 0.75;
-  sc->shepard_threshold = 0.85, sc->theta_threshold = 0.95;
-  sc->path = "unit";
-  return sc;
-}
 
 /* Appends an nx x ny lattice of spacing (and size) h with lower-left corner (x0, y0),
  * each point shifted by up to jitter h / 2 along each axis. */
@@ -302,6 +289,23 @@ static void test_split_conservation(void) {
   run_close(&two);
 }
 
+/* What rhod_sim_step does in its last stage, on a hand-made store with no walls: the
+ * scheme's fields of one right-hand side (cells over [lo, hi] made for R = 4 dx), then
+ * the refinement criteria with dx_min. */
+static void mark_store(rhod_scene *sc, rhod_particles *p, rhod_sph *s, rhod_cells *c, rhod_apr *a,
+                       const double lo[2], const double hi[2], double dx, double dx_min) {
+  CU_ASSERT_EQUAL_FATAL(rhod_sph_init(s, sc, p), RHOD_OK);
+  sync_to_device(p);
+  CU_ASSERT_EQUAL_FATAL(rhod_cells_init(c, lo, hi, 4 * dx, RHOD_CELL_REACH, p->cap), RHOD_OK);
+  rhod_sph_fill_state(s, p);
+  rhod_cells_build(c, p->x, p->y, p->n);
+  rhod_sph_rhs(s, p, c, (real)1e-4);
+  rhod_boundary bnd;
+  memset(&bnd, 0, sizeof bnd);
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_init(a, sc, dx_min), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(a, s, p, c, &bnd, 0), RHOD_OK);
+}
+
 /* ------------------------------------------------------------------------------------ */
 /* 3. rhod_apr_split on a hand-made store: where the children go and what they carry     */
 
@@ -327,20 +331,11 @@ static void test_split_geometry(void) {
   /* criterion 5 marks every particle, so every one gets its orientation searched */
   sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
   sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
-  rhod_sph s;
-  CU_ASSERT_EQUAL_FATAL(rhod_sph_init(&s, sc, &p), RHOD_OK);
-  sync_to_device(&p);
-  rhod_cells c;
   const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
-  CU_ASSERT_EQUAL_FATAL(rhod_cells_init(&c, lo, hi, 4 * dx, RHOD_CELL_REACH, p.cap), RHOD_OK);
-  rhod_sph_fill_state(&s, &p);
-  rhod_cells_build(&c, p.x, p.y, p.n);
-  rhod_sph_rhs(&s, &p, &c, (real)1e-4);
+  rhod_sph s;
+  rhod_cells c;
   rhod_apr a;
-  rhod_boundary bnd;
-  memset(&bnd, 0, sizeof bnd);
-  CU_ASSERT_EQUAL_FATAL(rhod_apr_init(&a, sc, dx / 2), RHOD_OK);
-  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&a, &s, &p, &c, &bnd, 0), RHOD_OK);
+  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
   /* split every 7th particle (edges included), whatever the criteria said */
   uint8_t *want = calloc((size_t)n0, 1);
   long k = 0;
@@ -528,21 +523,12 @@ static void test_criteria_1_2(void) {
   add_block(&p, 11 * dx, 23 * dx, 1, 1, 2 * dx, 0, &seed); /* centred on (12, 24) dx */
   const long n = (long)p.n;
   const double X0 = 0, X1 = 88 * dx, Y0 = 0, Y1 = 48 * dx;
-  rhod_sph s;
-  CU_ASSERT_EQUAL_FATAL(rhod_sph_init(&s, sc, &p), RHOD_OK);
-  sync_to_device(&p);
-  rhod_cells c;
   const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {X1 + 8 * dx, Y1 + 8 * dx};
-  CU_ASSERT_EQUAL_FATAL(rhod_cells_init(&c, lo, hi, 4 * dx, RHOD_CELL_REACH, p.cap), RHOD_OK);
-  rhod_sph_fill_state(&s, &p);
-  rhod_cells_build(&c, p.x, p.y, p.n);
-  rhod_sph_rhs(&s, &p, &c, (real)1e-4);
+  rhod_sph s;
+  rhod_cells c;
   rhod_apr a;
-  rhod_boundary bnd;
-  memset(&bnd, 0, sizeof bnd);
   /* dx_min below the fine size, so that every particle is evaluated */
-  CU_ASSERT_EQUAL_FATAL(rhod_apr_init(&a, sc, dx / 2), RHOD_OK);
-  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&a, &s, &p, &c, &bnd, 0), RHOD_OK);
+  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
   rhod_to_host(a.mark, (size_t)n);
   long grand = 0, checked = 0, wrong = 0;
   for (long i = 0; i < n; i++) {

@@ -7,6 +7,7 @@
 #include "rhod/sim.h"
 #include "rhod/sph.h"
 #include "sph_pair.h"
+#include "test_scene_util.h"
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -52,20 +53,6 @@ static void test_kernel_normalisation(void) {
 #endif
     }
   }
-}
-
-/* A minimal scene for the scheme's parameters. */
-static rhod_scene *unit_scene(double dx) {
-  rhod_scene *sc = calloc(1, sizeof *sc);
-  sc->t_end = 1, sc->output_every = 1, sc->cfl = 0.5, sc->cfl_visc = 0.025;
-  sc->dx = dx, sc->radius_ratio = 4, sc->kernel = RHOD_KERNEL_WENDLAND_C2;
-  sc->rho0 = 1000, sc->c0 = 20, sc->mu = 0;
-  sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = sc->free_surface = 1;
-  sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
-  sc->fs_lambda_low = 0.2, sc->fs_lambda_high = 0.75;
-  sc->shepard_threshold = 0.85, sc->theta_threshold = 0.95;
-  sc->path = "unit";
-  return sc;
 }
 
 /* A perturbed lattice of nx x ny particles of spacing dx in [0, nx dx] x [0, ny dx]. */
