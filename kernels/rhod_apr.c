@@ -114,29 +114,32 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
      * neighbour within 1.5 dx_i wins; ties keep the nearest-neighbour alignment. */
     const real e0 = sqrt(best), cx = ex / e0, cy = ey / e0, h = (real)0.25 * dxi;
     const real near2 = (real)2.25 * dxi * dxi;
-    real dk[6];
-    for (int k = 0; k < 6; k++)
-      dk[k] = near2;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = x[j] - xi, ry = y[j] - yi;
-      if (j != i && rx * rx + ry * ry < near2)
-        for (int k = 0; k < 6; k++) {
-          const real th = (real)(RHOD_PI / 12) * k, ct = cos(th), st = sin(th);
-          const real fx = ct * cx - st * cy, fy = st * cx + ct * cy; /* e turned by th */
+    /* One neighbour pass per orientation, each with a scalar minimum, and the turns
+     * made by a constant 15-degree rotation: an array of six minima, or cos/sin of a
+     * variable angle (fused into sincos() with pointer outputs), would be an
+     * addressable local, which GCC 12 nvptx puts in the warp-shared frame (offload.md,
+     * tests/offload_frames.sh). Only marked particles pay for the six passes. */
+    const real c15 = (real)0.96592582628906829, s15 = (real)0.25881904510252076;
+    real dbest = -1, fx = cx, fy = cy, bx = cx, by = cy;
+    for (int k = 0; k < 6; k++) {
+      real dk = near2;
+      RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
+        const real rx = x[j] - xi, ry = y[j] - yi;
+        if (j != i && rx * rx + ry * ry < near2)
           for (int q = 0; q < 4; q++) {
             const real sa = (q & 1) ? h : -h, sb = (q & 2) ? h : -h;
             const real qx = rx - (sa * fx - sb * fy), qy = ry - (sa * fy + sb * fx);
             const real d2 = qx * qx + qy * qy;
-            dk[k] = d2 < dk[k] ? d2 : dk[k];
+            dk = d2 < dk ? d2 : dk;
           }
-        }
+      }
+      RHOD_END_NEIGHBOURS
+      if (dk > dbest) /* strict: ties keep the lower turn */
+        dbest = dk, bx = fx, by = fy;
+      const real gx = c15 * fx - s15 * fy; /* e turned by a further 15 degrees */
+      fy = s15 * fx + c15 * fy, fx = gx;
     }
-    RHOD_END_NEIGHBOURS
-    int kb = 0;
-    for (int k = 1; k < 6; k++)
-      kb = dk[k] > dk[kb] ? k : kb;
-    const real th = (real)(RHOD_PI / 12) * kb, ct = cos(th), st = sin(th);
-    sd[4 * i + 2] = ct * cx - st * cy, sd[4 * i + 3] = st * cx + ct * cy;
+    sd[4 * i + 2] = bx, sd[4 * i + 3] = by;
   }
   return RHOD_OK;
 }
