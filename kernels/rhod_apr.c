@@ -144,7 +144,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   return RHOD_OK;
 }
 
-long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p) {
+long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rhod_boundary *b) {
   const long n = (long)p->n;
   a->split_last = 0;
   if (!a->mark || a->cap < p->n)
@@ -172,6 +172,8 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p) {
   const real *sd = a->sd;
   const uint64_t id0 = p->next_id;
   const real c2 = s->c0 * s->c0, ic2 = 1 / c2, rho0 = s->rho0;
+  const real *seg = b->seg, *circ = b->circ;
+  const int nseg = b->nseg, ncirc = b->ncirc;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     if (!mark[i])
@@ -185,12 +187,20 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p) {
     const real h = (real)0.25 * dxi;
     for (int k = 0; k < 4; k++) {
       const real sa = (k & 1) ? h : -h, sb = (k & 2) ? h : -h;
-      const real ox = sa * ex - sb * ey, oy = sa * ey + sb * ex;
+      /* Our choice (the paper is silent): a child that would land behind a wall, or
+       * nearer to it than half its size (where the lattice starts), is moved along the
+       * wall normal to half its size in front; a child behind a wall has no ghosts
+       * and was seen to blow up in the dam break within steps. Its pressure is
+       * projected at the moved place. */
+      const rhod_point q =
+          rhod_walls_keep_off(seg, nseg, circ, ncirc, xi + sa * ex - sb * ey,
+                              yi + sa * ey + sb * ex, (real)0.25 * dxi, (real)0.5 * dxi);
+      const real ox = q.x - xi, oy = q.y - yi;
       const long c = k == 0 ? i : n + cnt[i] + k - 1;
       /* Sec. V A: P_c = P_i + <grad P>^L_i . (x_c - x_i), rho_c from Eq. 2,
        * m_c = m_i/4 so that V_c = (V_i rho_i / 4) / rho_c */
       const real Pc = Pi + gx * ox + gy * oy;
-      x[c] = xi + ox, y[c] = yi + oy;
+      x[c] = q.x, y[c] = q.y;
       rho[c] = rho0 + Pc * ic2;
       m[c] = (real)0.25 * mi;
       dx[c] = (real)0.5 * dxi;

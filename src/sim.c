@@ -91,6 +91,13 @@ static double jitter_rand(uint64_t *st) {
   return (double)(*st >> 11) / 9007199254740992.0 - 0.5;
 }
 
+/* The jitter given to the lattice as it is filled. With dynamic refinement the
+ * lattice is filled unjittered, refined by the initial criteria cascade (whose splits
+ * then fall on the finer lattices), and jittered afterwards, each particle by its own
+ * size (restate_initial): jittered parents would give children that crowd their
+ * neighbours' children. */
+static double lattice_jitter(const rhod_scene *sc) { return sc->refine_dynamic ? 0 : sc->jitter; }
+
 /* Finest initial level asked by the refinement regions at (x, y); 0 outside all. */
 static int region_level(const rhod_scene *sc, double x, double y) {
   int l = 0;
@@ -100,57 +107,66 @@ static int region_level(const rhod_scene *sc, double x, double y) {
   return l;
 }
 
-/* One fluid particle of size dx at (x, y) of block b, with the block's initial state,
- * if the point is fluid (inside the block, not in an earlier block, not behind a
- * wall). Counts it; writes it when `write`. */
-static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t *n, int write) {
+/* The fluid block that owns (x, y): the first block whose shape holds the point, if
+ * the point is fluid (inside the domain, not behind a wall); -1 otherwise. */
+static int fluid_block_at(const rhod_sim *s, double x, double y) {
+  const rhod_scene *sc = s->sc;
+  if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1])
+    return -1;
+  if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0)
+    return -1;
+  for (unsigned b = 0; b < sc->n_fluid; b++) /* a point of an earlier block is not filled twice */
+    if (in_shape(&sc->fluid[b].shape, x, y))
+      return (int)b;
+  return -1;
+}
+
+/* Particle k of size dx at (x, y) with the initial state of block b; id k. */
+static void set_state(rhod_sim *s, unsigned b, size_t k, double x, double y, double dx) {
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
-  if (!in_shape(&B->shape, x, y))
-    return;
-  for (unsigned e = 0; e < b; e++) /* a point of an earlier block is not filled twice */
-    if (in_shape(&sc->fluid[e].shape, x, y))
-      return;
-  if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1])
-    return;
-  if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0)
-    return;
-  if (write) {
-    rhod_particles *p = &s->p;
-    const double g = hypot(sc->gravity[0], sc->gravity[1]);
-    const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
-    const double c2 = sc->c0 * sc->c0;
-    double P = 0;
-    if (B->pressure == RHOD_INIT_HYDROSTATIC) {
-      /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1) */
-      const double depth = shape_top(&B->shape, ex, ey) - (x * ex + y * ey);
-      P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
-    }
-    double u = B->velocity[0], v = B->velocity[1];
-    if (B->flow == RHOD_FLOW_TAYLOR_GREEN) {
-      const double k = 2 * M_PI / B->flow_L, U = B->flow_U;
-      u += U * sin(k * x) * cos(k * y);
-      v -= U * cos(k * x) * sin(k * y);
-      P += sc->rho0 * U * U / 4 * (cos(2 * k * x) + cos(2 * k * y));
-    } else if (B->flow == RHOD_FLOW_ROTATION) {
-      const double w = B->flow_omega;
-      u -= w * (y - B->flow_center[1]);
-      v += w * (x - B->flow_center[0]);
-      P += rotation_pressure(sc->rho0, w, B->shape.max[0] - B->shape.min[0],
-                             B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
-                             y - B->shape.min[1]);
-    }
-    const double rho = sc->rho0 + P / c2; /* Eq. 2 */
-    const size_t k = *n;
-    p->x[k] = (real)x;
-    p->y[k] = (real)y;
-    p->ux[k] = (real)u;
-    p->uy[k] = (real)v;
-    p->rho[k] = (real)rho;
-    p->m[k] = (real)(rho * dx * dx); /* m_i = rho_i(0) V_i(0) */
-    p->dx[k] = (real)dx;
-    p->id[k] = k;
+  rhod_particles *p = &s->p;
+  const double g = hypot(sc->gravity[0], sc->gravity[1]);
+  const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
+  const double c2 = sc->c0 * sc->c0;
+  double P = 0;
+  if (B->pressure == RHOD_INIT_HYDROSTATIC) {
+    /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1) */
+    const double depth = shape_top(&B->shape, ex, ey) - (x * ex + y * ey);
+    P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
   }
+  double u = B->velocity[0], v = B->velocity[1];
+  if (B->flow == RHOD_FLOW_TAYLOR_GREEN) {
+    const double kw = 2 * M_PI / B->flow_L, U = B->flow_U;
+    u += U * sin(kw * x) * cos(kw * y);
+    v -= U * cos(kw * x) * sin(kw * y);
+    P += sc->rho0 * U * U / 4 * (cos(2 * kw * x) + cos(2 * kw * y));
+  } else if (B->flow == RHOD_FLOW_ROTATION) {
+    const double w = B->flow_omega;
+    u -= w * (y - B->flow_center[1]);
+    v += w * (x - B->flow_center[0]);
+    P += rotation_pressure(sc->rho0, w, B->shape.max[0] - B->shape.min[0],
+                           B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
+                           y - B->shape.min[1]);
+  }
+  const double rho = sc->rho0 + P / c2; /* Eq. 2 */
+  p->x[k] = (real)x;
+  p->y[k] = (real)y;
+  p->ux[k] = (real)u;
+  p->uy[k] = (real)v;
+  p->rho[k] = (real)rho;
+  p->m[k] = (real)(rho * dx * dx); /* m_i = rho_i(0) V_i(0) */
+  p->dx[k] = (real)dx;
+  p->id[k] = k;
+}
+
+/* One fluid particle of size dx at (x, y) of block b, if the point belongs to block b
+ * (fluid_block_at). Counts it; writes it when `write`. */
+static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t *n, int write) {
+  if (fluid_block_at(s, x, y) != (int)b)
+    return;
+  if (write)
+    set_state(s, b, *n, x, y, dx);
   (*n)++;
 }
 
@@ -166,7 +182,8 @@ static void fill_cell(rhod_sim *s, unsigned b, const double lo[2], double dx0, d
     return;
   }
   for (int q = 0; q < 4; q++) {
-    const double j2x = s->sc->jitter * jitter_rand(rs), j2y = s->sc->jitter * jitter_rand(rs);
+    const double jit = lattice_jitter(s->sc);
+    const double j2x = jit * jitter_rand(rs), j2y = jit * jitter_rand(rs);
     fill_cell(s, b, lo, dx0, ci + ((q & 1) ? 0.25 : -0.25) * f, cj + ((q & 2) ? 0.25 : -0.25) * f,
               0.5 * f, l + 1, j2x, j2y, rs, n, write);
   }
@@ -192,7 +209,8 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
            * deforms affinely under a strain field, where Fickian shifting (uniform
            * concentration) cannot act, until it collapses (seen on the Taylor-Green
            * vortex) */
-          const double jx = sc->jitter * jitter_rand(&rs), jy = sc->jitter * jitter_rand(&rs);
+          const double jit = lattice_jitter(sc);
+          const double jx = jit * jitter_rand(&rs), jy = jit * jitter_rand(&rs);
           fill_cell(s, b, lo, dx, i + 0.5, j + 0.5, 1.0, 0, jx, jy, &rs, &n, pass);
         }
     }
@@ -218,6 +236,38 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
     }
   }
   return RHOD_OK;
+}
+
+/* After the initial criteria cascade: each particle gets the jitter of the scene,
+ * scaled by its own size, and the initial state of its block at its place, as if
+ * the lattice had been filled there (the split's projected pressure and m/4 are
+ * replaced by the exact initial fields, so the masses match the densities). A point
+ * that would leave its block keeps its lattice place; particles of no block (a child
+ * that landed outside its parent's block) keep their split state. */
+static int restate_initial(rhod_sim *s) {
+  rhod_particles *p = &s->p;
+  for (int f = 0; f < p->nfields; f++)
+    if (p->fields[f].persistent)
+      rhod_to_host(*p->fields[f].ptr, p->n * p->fields[f].elem);
+  uint64_t rs = 0x5eed;
+  const double jit = s->sc->jitter;
+  for (size_t k = 0; k < p->n; k++) {
+    const double x = p->x[k], y = p->y[k], dx = p->dx[k];
+    const int b = fluid_block_at(s, x, y);
+    const double xj = x + jit * dx * jitter_rand(&rs), yj = y + jit * dx * jitter_rand(&rs);
+    if (b < 0)
+      continue;
+    const uint64_t id = p->id[k];
+    if (fluid_block_at(s, xj, yj) == b)
+      set_state(s, (unsigned)b, k, xj, yj, dx);
+    else
+      set_state(s, (unsigned)b, k, x, y, dx);
+    p->id[k] = id;
+  }
+  for (int f = 0; f < p->nfields; f++)
+    if (p->fields[f].persistent)
+      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+  return rhod_sim_prepare(s, 1);
 }
 
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
@@ -302,7 +352,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   for (int round = 1; round < sc->levels; round++) {
     rhod_sph_rhs(&s->sph, p, &s->cells, (real)s->dt);
     st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, 0);
-    const long split = st == RHOD_OK ? rhod_apr_split(&s->apr, &s->sph, p) : -1;
+    const long split = st == RHOD_OK ? rhod_apr_split(&s->apr, &s->sph, p, &s->bnd) : -1;
     if (split < 0) {
       snprintf(err, errlen, "out of memory refining the initial particles");
       return RHOD_ERR_MEMORY;
@@ -315,7 +365,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
       return st;
   }
   s->apr.split_total = 0;
-  return RHOD_OK;
+  return restate_initial(s);
 }
 
 void rhod_sim_free(rhod_sim *s) {
@@ -459,7 +509,7 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   if (st != RHOD_OK || !s->apr.active)
     return st;
   /* the marked particles split before the next step, which sorts them in */
-  if (rhod_apr_split(&s->apr, &s->sph, p) < 0) {
+  if (rhod_apr_split(&s->apr, &s->sph, p, &s->bnd) < 0) {
     st = RHOD_ERR_MEMORY;
     goto mem;
   }

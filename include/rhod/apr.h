@@ -39,7 +39,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
                   const rhod_boundary *b, double t);
 
 /* Splits the marked fluid particles (Sec. V A) at their current state; returns how
- * many were split, or < 0 when memory ran out. Ghosts and cells are stale after it. */
-long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p);
+ * many were split, or < 0 when memory ran out. Children are kept off the walls of b
+ * (half their size). Ghosts and cells are stale after it. */
+long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rhod_boundary *b);
 
 #endif

@@ -11,6 +11,7 @@
 #include "rhod/config.h"
 #include "rhod/particles.h"
 #include "rhod/scene.h"
+#include <math.h>
 
 #define RHOD_SEG_STRIDE 8  /* ax, ay, nx, ny, tx, ty, length, noslip */
 #define RHOD_CIRC_STRIDE 5 /* cx, cy, radius, side (+1 fluid inside, -1 outside), noslip */
@@ -46,6 +47,37 @@ void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real radiu
 /* Reflects fluid particles that ended a step just behind a wall (see ghosts.c);
  * returns how many. */
 long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p);
+
+/* A point moved off the walls: where (x, y) lies less than `keep` in front of a wall
+ * (or behind it, by less than `back`), with its foot on the wall, it moves along the
+ * wall normal to stand `keep` in front; walls in order, segments then circles. For
+ * points placed near walls by a kernel (the APR split's children); inline, so that
+ * device loops can call it. */
+typedef struct {
+  real x, y;
+} rhod_point;
+
+static inline rhod_point rhod_walls_keep_off(const real *seg, int nseg, const real *circ, int ncirc,
+                                             real x, real y, real keep, real back) {
+  for (int s = 0; s < nseg; s++) {
+    const real *S = seg + RHOD_SEG_STRIDE * s;
+    const real rx = x - S[0], ry = y - S[1];
+    const real d = S[2] * rx + S[3] * ry, t = S[4] * rx + S[5] * ry;
+    if (d < keep && d > -back && t >= 0 && t <= S[6])
+      x += (keep - d) * S[2], y += (keep - d) * S[3];
+  }
+  for (int c = 0; c < ncirc; c++) {
+    const real *C = circ + RHOD_CIRC_STRIDE * c;
+    const real rx = x - C[0], ry = y - C[1], dist = sqrt(rx * rx + ry * ry);
+    const real d = C[3] > 0 ? C[2] - dist : dist - C[2];
+    if (d < keep && d > -back && dist > 0) {
+      const real ex = C[3] * (-rx / dist), ey = C[3] * (-ry / dist); /* into the fluid */
+      x += (keep - d) * ex, y += (keep - d) * ey;
+    }
+  }
+  const rhod_point q = {x, y};
+  return q;
+}
 
 /* Signed distance from a point to the nearest wall (positive on the fluid side);
  * +HUGE_VAL when there are no walls. Host side, for setup. */
