@@ -238,35 +238,42 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
   return RHOD_OK;
 }
 
-/* After the initial criteria cascade: each particle gets the jitter of the scene,
- * scaled by its own size, and the initial state of its block at its place, as if
- * the lattice had been filled there (the split's projected pressure and m/4 are
- * replaced by the exact initial fields, so the masses match the densities). A point
- * that would leave its block keeps its lattice place; particles of no block (a child
- * that landed outside its parent's block) keep their split state. */
-static int restate_initial(rhod_sim *s) {
-  rhod_particles *p = &s->p;
+static void persistent_to_host(rhod_particles *p) {
   for (int f = 0; f < p->nfields; f++)
     if (p->fields[f].persistent)
       rhod_to_host(*p->fields[f].ptr, p->n * p->fields[f].elem);
+}
+
+static void persistent_to_device(rhod_particles *p) {
+  for (int f = 0; f < p->nfields; f++)
+    if (p->fields[f].persistent)
+      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+}
+
+/* After the initial criteria cascade, whose splits fall on the finer lattices of the
+ * unjittered fill: each particle is jittered by the scene's jitter times its own size
+ * and gets the exact initial fields of its block where it stands, as if the lattice
+ * had been filled there (the split's projected pressure and m/4 are replaced, so the
+ * masses match the densities). A jitter that would take a point out of its block is
+ * not applied; a particle of no block (a child beyond its parent's block edge) keeps
+ * its split fields. */
+static int restate_initial(rhod_sim *s) {
+  rhod_particles *p = &s->p;
+  persistent_to_host(p);
   uint64_t rs = 0x5eed;
   const double jit = s->sc->jitter;
   for (size_t k = 0; k < p->n; k++) {
     const double x = p->x[k], y = p->y[k], dx = p->dx[k];
-    const int b = fluid_block_at(s, x, y);
     const double xj = x + jit * dx * jitter_rand(&rs), yj = y + jit * dx * jitter_rand(&rs);
+    const int b = fluid_block_at(s, x, y);
     if (b < 0)
       continue;
+    const int moved = fluid_block_at(s, xj, yj) == b;
     const uint64_t id = p->id[k];
-    if (fluid_block_at(s, xj, yj) == b)
-      set_state(s, (unsigned)b, k, xj, yj, dx);
-    else
-      set_state(s, (unsigned)b, k, x, y, dx);
+    set_state(s, (unsigned)b, k, moved ? xj : x, moved ? yj : y, dx);
     p->id[k] = id;
   }
-  for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent)
-      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+  persistent_to_device(p);
   return rhod_sim_prepare(s, 1);
 }
 
@@ -325,10 +332,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     snprintf(err, errlen, "out of memory setting up the scheme");
     return st;
   }
-  /* the persistent state goes to the device */
-  for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent)
-      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+  persistent_to_device(p); /* the persistent state goes to the device */
   const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
   const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
   /* one grid made for the finest radius; coarser particles scan more cells (cells.h) */
@@ -343,8 +347,10 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     return st;
   s->dt = rhod_sph_dt(&s->sph, p);
   st = rhod_sim_prepare(s, 1);
-  if (st != RHOD_OK || !s->apr.active)
+  if (st != RHOD_OK)
     return st;
+  if (!s->apr.active)
+    return RHOD_OK;
   /* The initial lattice is refined by the criteria before the first step, until none
    * asks for more (at most levels - 1 rounds), so the run starts from a layout that
    * satisfies them (paper 002 Sec. V B: "the initial particle setup is chosen to
