@@ -634,8 +634,15 @@ void rhod_probe_values(rhod_sim *s, double *values) {
 void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
   rhod_particles *p = &s->p;
   const size_t n = p->n;
-  /* P is refreshed for the prepared state; fs is the last stage's detection */
+  /* P and the free-surface flags are refreshed for the prepared state: the flags of
+   * the last stage belong to the particle order before the step's sort (and to the
+   * stage's positions), so they are detected again here when the neighbours are
+   * fresh (pass A gives lambda, L and grad Gamma) */
   rhod_sph_fill_state(&s->sph, p);
+  if (s->neighbours_fresh) {
+    rhod_sph_pass_a(&s->sph, p, &s->cells);
+    rhod_sph_pass_free_surface(&s->sph, p, &s->cells);
+  }
   real *const f[8] = {p->x, p->y, p->ux, p->uy, p->rho, s->sph.P, p->m, p->dx};
   for (int k = 0; k < 8; k++)
     rhod_to_host(f[k], n * sizeof(real));

@@ -354,6 +354,60 @@ static void test_split_keeps_off_walls(void) {
   run_close(&r);
 }
 
+/* Free-surface flags of a snapshot: a tank at rest, jittered, in one resolution, in
+ * three levels laid out in horizontal bands (coarse at the bottom, fine at the top,
+ * as the free-surface criterion lays them out), and refined by criterion 3 at t = 0.
+ * Only the top rows may be flagged, at the start and after two steps: a fine particle
+ * facing coarser ones must not take their sparser lattice for a void, and the flags
+ * must follow the particles through the sort that moves the split children in
+ * (fetched flags were once the last stage's: none at the start, and afterwards in the
+ * particle order before the sort). */
+static long fs_below(const char *tag, const char *refine) {
+  char yaml[1024], err[512] = "";
+  snprintf(yaml, sizeof yaml,
+           "time: {end: 1, output_every: 1}\n"
+           "particles: {dx: 0.01, jitter: 0.3}\n"
+           "physics: {c0: 10, gravity: [0, -9.81]}\n"
+           "fluid:\n"
+           "  - rect: {min: [0, 0], max: [0.32, 0.16]}\n"
+           "    pressure: hydrostatic\n"
+           "walls:\n"
+           "  - rect: {min: [0, 0], max: [0.32, 0.24]}\n"
+           "%s",
+           refine);
+  run r;
+  CU_ASSERT_FATAL(run_open(&r, tag, yaml));
+  long below = 0;
+  for (int step = 0; step <= 2; step++) {
+    if (step > 0) {
+      CU_ASSERT_EQUAL_FATAL(rhod_sim_step(r.sim, r.sim->dt, err, sizeof err), RHOD_OK);
+      CU_ASSERT_EQUAL_FATAL(rhod_sim_prepare(r.sim, 1), RHOD_OK);
+    }
+    rhod_snapshot_view v;
+    rhod_sim_fetch(r.sim, &v);
+    long top = 0;
+    for (size_t i = 0; i < v.n; i++) {
+      const int deep = v.y[i] < 0.16 - 2 * v.size[i];
+      below += v.fs[i] && deep, top += v.fs[i] && !deep;
+    }
+    CU_ASSERT(top >= 32);
+  }
+  run_close(&r);
+  return below;
+}
+
+static void test_free_surface_flags(void) {
+  CU_ASSERT_EQUAL(fs_below("fs1", ""), 0);
+  CU_ASSERT_EQUAL(fs_below("fs3", "refinement:\n"
+                                  "  levels: 3\n"
+                                  "  dynamic: false\n"
+                                  "  regions:\n"
+                                  "    - {level: 1, rect: {min: [-1, 0.06], max: [1, 1]}}\n"
+                                  "    - {level: 2, rect: {min: [-1, 0.11], max: [1, 1]}}\n"),
+                  0);
+  CU_ASSERT_EQUAL(fs_below("fsdyn", "refinement: {levels: 2, free_surface: true}\n"), 0);
+}
+
 /* What rhod_sim_step does in its last stage, on a hand-made store with no walls: the
  * scheme's fields of one right-hand side (cells over [lo, hi] made for R = 4 dx), then
  * the refinement criteria with dx_min. */
@@ -741,6 +795,7 @@ int main(void) {
       {"split children are kept off the walls", test_split_keeps_off_walls},
       {"dx_min is never crossed", test_dx_min_never_crossed},
       {"criteria 1 and 2", test_criteria_1_2},
+      {"snapshot free-surface flags, across levels and splits", test_free_surface_flags},
       {"levels 2 without splits = single resolution", test_equal_sizes_single_resolution},
       {"... also in a corner of the tank", test_equal_sizes_single_resolution_corner},
   };
