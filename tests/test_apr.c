@@ -336,10 +336,10 @@ static void test_split_keeps_off_walls(void) {
     m1 += v.m[i];
     const double d = rhod_wall_distance(&r.sim->bnd, v.x[i], v.y[i]) / v.size[i];
     worst = fmin(worst, d);
-    off += d < 0.5 - 1e-9;
+    off += d < 0.5 - TOL(1e-9);
   }
   CU_ASSERT_EQUAL(off, 0);
-  CU_ASSERT(worst > 0.5 - 1e-9);
+  CU_ASSERT(worst > 0.5 - TOL(1e-9));
   CU_ASSERT(rel_close(m0, m1, TOL(1e-14), m0));
   /* the projected pressure is hydrostatic where the child stands (linear field, exact
    * up to the gradient error near the surface): within 5 % of rho0 g dx, where the
