@@ -183,3 +183,15 @@ void rhod_particles_permute(rhod_particles *p) {
       permute_bytes(*f->ptr, p->scratch, p->perm, p->n, f->elem);
   }
 }
+
+void rhod_particles_to_device(rhod_particles *p) {
+  for (int f = 0; f < p->nfields; f++)
+    if (p->fields[f].persistent)
+      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
+}
+
+void rhod_particles_to_host(rhod_particles *p) {
+  for (int f = 0; f < p->nfields; f++)
+    if (p->fields[f].persistent)
+      rhod_to_host(*p->fields[f].ptr, p->n * p->fields[f].elem);
+}

@@ -238,18 +238,6 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
   return RHOD_OK;
 }
 
-static void persistent_to_host(rhod_particles *p) {
-  for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent)
-      rhod_to_host(*p->fields[f].ptr, p->n * p->fields[f].elem);
-}
-
-static void persistent_to_device(rhod_particles *p) {
-  for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent)
-      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
-}
-
 /* After the initial criteria cascade, whose splits fall on the finer lattices of the
  * unjittered fill: each particle is jittered by the scene's jitter times its own size
  * and gets the exact initial fields of its block where it stands, as if the lattice
@@ -259,7 +247,7 @@ static void persistent_to_device(rhod_particles *p) {
  * its split fields. */
 static int restate_initial(rhod_sim *s) {
   rhod_particles *p = &s->p;
-  persistent_to_host(p);
+  rhod_particles_to_host(p);
   uint64_t rs = 0x5eed;
   const double jit = s->sc->jitter;
   for (size_t k = 0; k < p->n; k++) {
@@ -273,7 +261,7 @@ static int restate_initial(rhod_sim *s) {
     set_state(s, (unsigned)b, k, moved ? xj : x, moved ? yj : y, dx);
     p->id[k] = id;
   }
-  persistent_to_device(p);
+  rhod_particles_to_device(p);
   return rhod_sim_prepare(s, 1);
 }
 
@@ -332,7 +320,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     snprintf(err, errlen, "out of memory setting up the scheme");
     return st;
   }
-  persistent_to_device(p); /* the persistent state goes to the device */
+  rhod_particles_to_device(p); /* the persistent state goes to the device */
   const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
   const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
   /* one grid made for the finest radius; coarser particles scan more cells (cells.h) */

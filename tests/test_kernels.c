@@ -90,12 +90,7 @@ static void cloud_make(cloud *cl, int nx, int ny, double dx, double jitter, unsi
   cloud_make_reach(cl, nx, ny, dx, jitter, seed, RHOD_CELL_REACH);
 }
 
-static void cloud_sync(cloud *cl) {
-  rhod_particles *p = &cl->p;
-  for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent)
-      rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
-}
+static void cloud_sync(cloud *cl) { rhod_particles_to_device(&cl->p); }
 
 static void cloud_free(cloud *cl) {
   rhod_cells_free(&cl->c);
@@ -316,9 +311,7 @@ static void test_walls_guard(void) {
   for (int i = 0; i < 4; i++)
     p.x[i] = X[i], p.y[i] = Y[i], p.ux[i] = U[i], p.uy[i] = V[i], p.dx[i] = (real)0.01;
   p.n = 4;
-  for (int f = 0; f < p.nfields; f++)
-    if (p.fields[f].persistent)
-      rhod_to_device(*p.fields[f].ptr, p.n * p.fields[f].elem);
+  rhod_particles_to_device(&p);
   CU_ASSERT_EQUAL(rhod_walls_guard(&b, &p), 2);
   rhod_to_host(p.x, 4 * sizeof(real));
   rhod_to_host(p.y, 4 * sizeof(real));

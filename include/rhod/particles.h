@@ -50,6 +50,10 @@ int rhod_particles_add_field(rhod_particles *p, const char *name, void **ptr, si
 /* Grows every array to at least `cap` (keeps content of persistent ones). */
 int rhod_particles_reserve(rhod_particles *p, size_t cap);
 void rhod_particles_free(rhod_particles *p);
+/* Copies the persistent arrays of the fluid [0, n) to the device, or back to the host
+ * (a host-side fill or edit, an inspection). */
+void rhod_particles_to_device(rhod_particles *p);
+void rhod_particles_to_host(rhod_particles *p);
 /* Reorders the persistent arrays of the fluid: new[k] = old[perm[k]], k < n.
  * perm lives on the device (p->perm). */
 void rhod_particles_permute(rhod_particles *p);
