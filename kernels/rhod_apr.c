@@ -106,40 +106,57 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     mark[i] = (uint8_t)m;
     if (!m || !(best < R2))
       continue;
-    /* Orientation of the children's square (Sec. V A, Fig. 5): the paper aligns it
-     * with the direction to the nearest neighbour "to maximize the minimum
-     * inter-particle distance once the refinement is completed". Our choice: that
-     * direction and five more turned by 15, 30, ... 75 degrees (the square repeats
-     * every 90) are tried, and the one whose four children stay farthest from every
-     * neighbour within 1.5 dx_i wins; ties keep the nearest-neighbour alignment. */
-    const real e0 = sqrt(best), cx = ex / e0, cy = ey / e0, h = (real)0.25 * dxi;
-    const real near2 = (real)2.25 * dxi * dxi;
-    /* One neighbour pass per orientation, each with a scalar minimum, and the turns
-     * made by a constant 15-degree rotation: an array of six minima, or cos/sin of a
-     * variable angle (fused into sincos() with pointer outputs), would be an
-     * addressable local, which GCC 12 nvptx puts in the warp-shared frame (offload.md,
-     * tests/offload_frames.sh). Only marked particles pay for the six passes. */
+    /* Pattern of the children (Sec. V A, Fig. 5). The paper turns the square of side
+     * dx_i/2 towards the nearest neighbour "to maximize the minimum inter-particle
+     * distance once the refinement is completed". Our generalisation (docs/choices.md):
+     * a rectangle of the same area, sides a dx_i/2 along e and dx_i/(2a) across, e the
+     * nearest-neighbour direction turned by 0, 15, ... 75 degrees and a in 1.25^-4 ..
+     * 1.25^4 (a and 1/a cover the other half turn). A pattern scores the smaller of
+     * its sibling spacing, min(a, 1/a) dx_i/2, and, for every neighbour j within
+     * 2 dx_i (ghosts too, so a wall counts), twice the distance by which each child
+     * stays on i's side of the i-j interface point x_i + w_i (x_j - x_i) of Eq. 12:
+     * the distance to j's children if j splits alike. The best score wins; ties keep
+     * the square aligned with the nearest neighbour (the paper's pattern), which is
+     * what a regular lattice gets. On a strained lattice (rows squeezed to 0.4 dx by
+     * a dam break's stretching) the square would put a child nearly on top of a
+     * neighbour's child; the rectangle follows the strain and the children form the
+     * same strained lattice at half the spacing.
+     * One neighbour pass per pattern, each with a scalar minimum, the turns made by a
+     * constant 15-degree rotation: an array of minima, or cos/sin of a variable angle
+     * (fused into sincos() with pointer outputs), would be an addressable local, which
+     * GCC 12 nvptx puts in the warp-shared frame (offload.md, tests/offload_frames.sh).
+     * Only marked particles pay for the passes. */
+    const real e0 = sqrt(best), h = (real)0.25 * dxi, reach = 2 * dxi, reach2 = reach * reach;
     const real c15 = (real)0.96592582628906829, s15 = (real)0.25881904510252076;
-    real dbest = -1, fx = cx, fy = cy, bx = cx, by = cy;
+    real sbest = (real)-1e30, fx = ex / e0, fy = ey / e0, bx = fx, by = fy;
     for (int k = 0; k < 6; k++) {
-      real dk = near2;
-      RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-        const real rx = x[j] - xi, ry = y[j] - yi;
-        if (j != i && rx * rx + ry * ry < near2)
-          for (int q = 0; q < 4; q++) {
-            const real sa = (q & 1) ? h : -h, sb = (q & 2) ? h : -h;
-            const real qx = rx - (sa * fx - sb * fy), qy = ry - (sa * fy + sb * fx);
-            const real d2 = qx * qx + qy * qy;
-            dk = d2 < dk ? d2 : dk;
+      real up = 1;
+      for (int q = 0; q < 9; q++) {
+        /* q = 0: a = 1; then 1.25, 0.8, 1.25^2, 1.25^-2, ... */
+        up = (q & 1) ? up * (real)1.25 : up;
+        const real a = (q & 1) || q == 0 ? up : 1 / up, ha = h * a, hb = h / a;
+        real score = 2 * (a < 1 ? ha : hb);
+        RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
+          const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+          if (j != i && r2 < reach2) {
+            const real r = sqrt(r2), dxj = dx[j],
+                       wr = dxj == dxi ? (real)0.5 * r : dxi / (dxi + dxj) * r;
+            /* the child farthest along n_ij: |o.n| is largest at the corner whose
+             * signs match those of (e.n, e_perp.n) */
+            const real en = (fx * rx + fy * ry) / r, pn = (fx * ry - fy * rx) / r;
+            const real on = ha * fabs(en) + hb * fabs(pn);
+            const real sj = 2 * (wr - on);
+            score = sj < score ? sj : score;
           }
+        }
+        RHOD_END_NEIGHBOURS
+        if (score > sbest) /* strict: ties keep the earlier pattern */
+          sbest = score, bx = a * fx, by = a * fy;
       }
-      RHOD_END_NEIGHBOURS
-      if (dk > dbest) /* strict: ties keep the lower turn */
-        dbest = dk, bx = fx, by = fy;
       const real gx = c15 * fx - s15 * fy; /* e turned by a further 15 degrees */
       fy = s15 * fx + c15 * fy, fx = gx;
     }
-    sd[4 * i + 2] = bx, sd[4 * i + 3] = by;
+    sd[4 * i + 2] = bx, sd[4 * i + 3] = by; /* e scaled by the aspect a */
   }
   return RHOD_OK;
 }
@@ -180,13 +197,16 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
       continue;
     const real xi = x[i], yi = y[i], dxi = dx[i], mi = m[i];
     const real Pi = c2 * (rho[i] - rho0); /* Eq. 2 */
-    const real gx = sd[4 * i], gy = sd[4 * i + 1], ex = sd[4 * i + 2], ey = sd[4 * i + 3];
+    const real gx = sd[4 * i], gy = sd[4 * i + 1];
     /* Fig. 5: children at the corners of a square of side dx_i/2 centred on x_i (on
      * the circle of radius dx_i/(2 sqrt 2)), sides along and across the direction e
-     * to the nearest neighbour */
-    const real h = (real)0.25 * dxi;
+     * to the nearest neighbour; in general the rectangle of the same area and aspect
+     * a chosen by rhod_apr_mark, which stores a e */
+    const real a = sqrt(sd[4 * i + 2] * sd[4 * i + 2] + sd[4 * i + 3] * sd[4 * i + 3]);
+    const real ex = sd[4 * i + 2] / a, ey = sd[4 * i + 3] / a;
+    const real ha = (real)0.25 * dxi * a, hb = (real)0.25 * dxi / a;
     for (int k = 0; k < 4; k++) {
-      const real sa = (k & 1) ? h : -h, sb = (k & 2) ? h : -h;
+      const real sa = (k & 1) ? ha : -ha, sb = (k & 2) ? hb : -hb;
       /* Our choice (the paper is silent): a child that would land behind a wall, or
        * nearer to it than half its size (where the lattice starts), is moved along the
        * wall normal to half its size in front; a child behind a wall has no ghosts
@@ -194,7 +214,7 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
        * projected at the moved place. */
       const rhod_point q =
           rhod_walls_keep_off(seg, nseg, circ, ncirc, xi + sa * ex - sb * ey,
-                              yi + sa * ey + sb * ex, (real)0.25 * dxi, (real)0.5 * dxi);
+                              yi + sa * ey + sb * ex, (real)0.125 * dxi, (real)0.5 * dxi);
       const real ox = q.x - xi, oy = q.y - yi;
       const long c = k == 0 ? i : n + cnt[i] + k - 1;
       /* Sec. V A: P_c = P_i + <grad P>^L_i . (x_c - x_i), rho_c from Eq. 2,

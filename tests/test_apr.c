@@ -291,10 +291,11 @@ static void test_split_conservation(void) {
 }
 
 /* Children are kept off the walls: a jittered lattice (parents a quarter to three
- * quarters of dx from the walls) split everywhere (criterion 5 with no bound) puts
- * children up to 0.35 dx behind the walls without it. Every particle must stand at
- * least half its size in front of every wall, carry the pressure projected to where it
- * stands, and the mass must be kept. */
+ * quarters of dx from the walls) split everywhere (criterion 5 with no bound). The
+ * pattern's score sees the walls' ghosts, yet without the push the nearest child stands
+ * 0.14 of its size from a wall. Every particle must stand at least a quarter of its size
+ * in front of every wall, carry the pressure projected to where it stands, and the mass
+ * must be kept. */
 static void test_split_keeps_off_walls(void) {
   run r;
   CU_ASSERT_FATAL(run_open(&r, "walls",
@@ -324,10 +325,11 @@ static void test_split_keeps_off_walls(void) {
     m1 += v.m[i];
     const double d = rhod_wall_distance(&r.sim->bnd, v.x[i], v.y[i]) / v.size[i];
     worst = fmin(worst, d);
-    off += d < 0.5 - TOL(1e-9);
+    off += d < 0.25 - TOL(1e-9);
   }
+  printf("\nwalls: nearest child at %.3f of its size from a wall\n", worst);
   CU_ASSERT_EQUAL(off, 0);
-  CU_ASSERT(worst > 0.5 - TOL(1e-9));
+  CU_ASSERT(worst > 0.25 - TOL(1e-9));
   CU_ASSERT(rel_close(m0, m1, TOL(1e-14), m0));
   /* the projected pressure is hydrostatic where the child stands (linear field, exact
    * up to the gradient error near the surface): within 5 % of rho0 g dx, where the
@@ -476,9 +478,9 @@ static void test_split_geometry(void) {
   rhod_snapshot_view v = {.n = p.n, .id = p.id};
   CU_ASSERT(ids_unique(&v, p.next_id));
   long wrong_unmarked = 0, wrong_count = 0, wrong_id = 0, wrong_state = 0, wrong_pressure = 0;
-  double edist = 0, eside = 0, ediag = 0, ecentre = 0;
+  double erect = 0, ecentre = 0;
   long worse = 0, turned = 0;
-  const double h = dx / 2, d = dx * sqrt(2) / 4; /* child size, distance to the parent */
+  const double h = dx / 2; /* child size */
   for (long i = 0; i < n0; i++) {
     const real *B = before + 6 * i;
     if (!want[i]) {
@@ -500,54 +502,70 @@ static void test_split_geometry(void) {
       continue;
     }
     int keeps = 0;
-    double cx = 0, cy = 0;
+    double cx = 0, cy = 0, ox[4], oy[4];
     for (int q = 0; q < 4; q++) {
       const long j = ch[q];
       keeps += j == i && p.id[j] == (uint64_t)i;
       wrong_id += j != i && p.id[j] < id0;
       wrong_state += p.m[j] != (real)0.25 * B[5] || p.dx[j] != (real)h;
-      const double ox = p.x[j] - B[0], oy = p.y[j] - B[1];
-      edist = fmax(edist, fabs(hypot(ox, oy) - d) / dx);
-      cx += p.x[j] / 4, cy += p.y[j] / 4;
+      ox[q] = p.x[j] - B[0], oy[q] = p.y[j] - B[1];
+      cx += ox[q] / 4, cy += oy[q] / 4;
       /* P_c = P_i + grad P . (x_c - x_i): exactly the linear field at x_c */
       const double Pc = ((double)p.rho[j] - rho0) * c0 * c0;
       wrong_pressure += fabs(Pc - (ga * p.x[j] + gb * p.y[j] + gc)) > TOL(1e-5) * 1e4;
-      /* a square of side dx/2: two neighbours at dx/2, one across at dx/sqrt 2 */
-      int sides = 0, diags = 0;
-      for (int t = 0; t < 4; t++) {
-        if (t == q)
-          continue;
-        const double r = hypot(p.x[ch[t]] - p.x[j], p.y[ch[t]] - p.y[j]);
-        if (fabs(r - h) < TOL(1e-9) * dx)
-          sides++;
-        else if (fabs(r - h * sqrt(2)) < TOL(1e-9) * dx)
-          diags++;
-        eside = fmax(eside, fmin(fabs(r - h), fabs(r - h * sqrt(2))) / dx);
-      }
-      ediag += sides != 2 || diags != 1;
     }
     wrong_id += keeps != 1;
-    ecentre = fmax(ecentre, hypot(cx - B[0], cy - B[1]) / dx);
-    /* orientation (Sec. V A): the children must stay at least as far from the other
-     * particles (as they were before the split) as a square aligned with the direction
-     * to the nearest neighbour would */
-    double dmin_got = HUGE_VAL, dmin_nn = HUGE_VAL;
-    int aligned = 1;
+    ecentre = fmax(ecentre, hypot(cx, cy) / dx);
+    /* Fig. 5 generalised: a rectangle centred on the parent with the area of the square
+     * of side dx/2: each child has one sibling at distance s1, one at s2, and one across
+     * at the diagonal, with s1 s2 = (dx/2)^2 and s1^2 + s2^2 = diagonal^2 */
+    for (int q = 0; q < 4; q++) {
+      double r[3];
+      int nr = 0;
+      for (int t = 0; t < 4; t++)
+        if (t != q)
+          r[nr++] = hypot(ox[t] - ox[q], oy[t] - oy[q]);
+      for (int a1 = 0; a1 < 3; a1++) /* sort the three distances */
+        for (int a2 = a1 + 1; a2 < 3; a2++)
+          if (r[a2] < r[a1]) {
+            const double tmp = r[a1];
+            r[a1] = r[a2], r[a2] = tmp;
+          }
+      erect = fmax(erect, fabs(r[0] * r[1] - h * h) / (h * h));
+      erect = fmax(erect, fabs(r[0] * r[0] + r[1] * r[1] - r[2] * r[2]) / (h * h));
+    }
+    /* orientation and aspect (Sec. V A, docs/choices.md): the pattern must score at
+     * least as well as the paper's square aligned with the nearest neighbour; the
+     * score is the smaller of the sibling spacing and, over the particles within
+     * 2 dx before the split, twice the distance by which every child stays on the
+     * parent's side of the mid-point (equal sizes: w_i = 1/2) */
+    double sq_x[4], sq_y[4];
     for (int q = 0; q < 4; q++) {
       const double sa = (q & 1) ? dx / 4 : -dx / 4, sb = (q & 2) ? dx / 4 : -dx / 4;
-      const double ax = B[0] + sa * e[2 * i] - sb * e[2 * i + 1];
-      const double ay = B[1] + sa * e[2 * i + 1] + sb * e[2 * i];
-      const double ox = p.x[ch[q]] - B[0], oy = p.y[ch[q]] - B[1];
-      aligned &= fabs(fabs(ox * e[2 * i] + oy * e[2 * i + 1]) - dx / 4) < TOL(1e-12) * dx;
-      for (long j = 0; j < n0; j++) {
-        if (j == i)
-          continue;
-        const real *Bj = before + 6 * j;
-        dmin_got = fmin(dmin_got, hypot(p.x[ch[q]] - Bj[0], p.y[ch[q]] - Bj[1]));
-        dmin_nn = fmin(dmin_nn, hypot(ax - Bj[0], ay - Bj[1]));
+      sq_x[q] = sa * e[2 * i] - sb * e[2 * i + 1], sq_y[q] = sa * e[2 * i + 1] + sb * e[2 * i];
+    }
+    double s_got = HUGE_VAL, s_sq = dx / 2;
+    for (int q = 0; q < 4; q++)
+      for (int t = q + 1; t < 4; t++)
+        s_got = fmin(s_got, hypot(ox[t] - ox[q], oy[t] - oy[q]));
+    for (long j = 0; j < n0; j++) {
+      const real *Bj = before + 6 * j;
+      const double rx = Bj[0] - B[0], ry = Bj[1] - B[1], r = hypot(rx, ry);
+      if (j == i || r >= 2 * dx)
+        continue;
+      for (int q = 0; q < 4; q++) {
+        s_got = fmin(s_got, 2 * (0.5 * r - (ox[q] * rx + oy[q] * ry) / r));
+        s_sq = fmin(s_sq, 2 * (0.5 * r - (sq_x[q] * rx + sq_y[q] * ry) / r));
       }
     }
-    worse += dmin_got < dmin_nn - TOL(1e-12) * dx;
+    int aligned = 1;
+    for (int q = 0; q < 4; q++) { /* the children are the square's corners, in any order */
+      int found = 0;
+      for (int t = 0; t < 4; t++)
+        found |= hypot(ox[q] - sq_x[t], oy[q] - sq_y[t]) < TOL(1e-12) * dx;
+      aligned &= found;
+    }
+    worse += s_got < s_sq - TOL(1e-12) * dx;
     turned += !aligned;
   }
   CU_ASSERT(k > 50);
@@ -556,15 +574,64 @@ static void test_split_geometry(void) {
   CU_ASSERT_EQUAL(wrong_id, 0);
   CU_ASSERT_EQUAL(wrong_state, 0);
   CU_ASSERT_EQUAL(wrong_pressure, 0);
-  CU_ASSERT(edist < TOL(1e-12));
-  CU_ASSERT(eside < TOL(1e-12));
-  CU_ASSERT(ediag == 0);
+  CU_ASSERT(erect < TOL(1e-12));
   CU_ASSERT(ecentre < TOL(1e-12));
   CU_ASSERT_EQUAL(worse, 0);
   CU_ASSERT(turned > 0); /* on a jittered lattice the search does turn some squares */
   free(want);
   free(before);
   free(e);
+  rhod_apr_free(&a);
+  rhod_cells_free(&c);
+  rhod_particles_free(&p);
+  free(sc);
+}
+
+/* A strained lattice, as a dam break's stretching leaves it: rows 2.5 dx apart, particles
+ * 0.4 dx apart along them (the same area per particle). Split everywhere, the paper's
+ * square turned to the nearest neighbour would put each child 0.1 dx from a neighbour's
+ * child; the rectangle that follows the strain keeps every pair at least 0.39 of a
+ * child's size apart (aspect 1.25^-4: siblings 0.205 dx, families 0.195 dx). */
+static void test_split_strained_lattice(void) {
+  const double dx = 0.01, sx = 2.5 * dx, sy = 0.4 * dx, rho0 = 1000;
+  rhod_scene *sc = unit_scene(dx);
+  rhod_particles p;
+  const int nx = 8, ny = 60;
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, (size_t)(nx * ny) + 8), RHOD_OK);
+  for (int a = 0; a < nx; a++)
+    for (int b = 0; b < ny; b++) {
+      const size_t k = p.n++;
+      p.x[k] = (real)((a + 0.5) * sx), p.y[k] = (real)((b + 0.5) * sy);
+      p.ux[k] = p.uy[k] = 0;
+      p.rho[k] = (real)rho0, p.m[k] = (real)(rho0 * dx * dx), p.dx[k] = (real)dx;
+      p.id[k] = k;
+    }
+  p.next_id = p.n;
+  const long n0 = (long)p.n;
+  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {nx * sx + 8 * dx, ny * sy + 8 * dx};
+  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
+  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  rhod_sph s;
+  rhod_cells c;
+  rhod_apr a;
+  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
+  rhod_boundary nowalls;
+  memset(&nowalls, 0, sizeof nowalls);
+  CU_ASSERT_EQUAL(rhod_apr_split(&a, &s, &p, &nowalls), n0);
+  rhod_particles_to_host(&p);
+  CU_ASSERT_EQUAL_FATAL((long)p.n, 4 * n0);
+  /* nearest pair, away from the block's ends (where the rows stop) */
+  double dmin = HUGE_VAL;
+  for (long i = 0; i < (long)p.n; i++) {
+    if (p.y[i] < 4 * dx || p.y[i] > ny * sy - 4 * dx)
+      continue;
+    for (long j = 0; j < (long)p.n; j++)
+      if (j != i)
+        dmin = fmin(dmin, hypot(p.x[j] - p.x[i], p.y[j] - p.y[i]));
+  }
+  printf("\nstrained lattice: nearest pair after the split %.3f of a child's size\n",
+         dmin / (dx / 2));
+  CU_ASSERT(dmin > 0.38 * dx / 2);
   rhod_apr_free(&a);
   rhod_cells_free(&c);
   rhod_particles_free(&p);
@@ -778,6 +845,7 @@ int main(void) {
       {"mixed-size neighbour search = brute force", test_mixed_size_neighbours},
       {"a split round conserves mass and momenta", test_split_conservation},
       {"split geometry and children's state", test_split_geometry},
+      {"split pattern on a strained lattice", test_split_strained_lattice},
       {"split children are kept off the walls", test_split_keeps_off_walls},
       {"dx_min is never crossed", test_dx_min_never_crossed},
       {"criteria 1 and 2", test_criteria_1_2},
