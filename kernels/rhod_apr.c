@@ -208,8 +208,9 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
     for (int k = 0; k < 4; k++) {
       const real sa = (k & 1) ? ha : -ha, sb = (k & 2) ? hb : -hb;
       /* Our choice (the paper is silent): a child that would land behind a wall, or
-       * nearer to it than half its size (where the lattice starts), is moved along the
-       * wall normal to half its size in front; a child behind a wall has no ghosts
+       * nearer to it than a quarter of its size, is moved along the wall normal to a
+       * quarter of its size in front (half would push both children of a parent
+       * squeezed against the wall onto one line); a child behind a wall has no ghosts
        * and was seen to blow up in the dam break within steps. Its pressure is
        * projected at the moved place. */
       const rhod_point q =
