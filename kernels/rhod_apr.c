@@ -139,8 +139,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
         RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
           const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
           if (j != i && r2 < reach2) {
-            const real r = sqrt(r2), dxj = dx[j],
-                       wr = dxj == dxi ? (real)0.5 * r : dxi / (dxi + dxj) * r;
+            /* w_i r of Eq. 12 (exactly r/2 at equal sizes: x / (x + x) = 0.5) */
+            const real r = sqrt(r2), wr = dxi / (dxi + dx[j]) * r;
             /* the child farthest along n_ij: |o.n| is largest at the corner whose
              * signs match those of (e.n, e_perp.n) */
             const real en = (fx * rx + fy * ry) / r, pn = (fx * ry - fy * rx) / r;

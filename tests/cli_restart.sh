@@ -44,7 +44,7 @@ check "SIGTERM: summary says interrupted" -- grep -q '"status": "interrupted"' "
 expect 0 "resume after SIGTERM" -- "$RHOD" resume "$T/c"
 check "signal-resumed run identical to the uninterrupted one" -- same_outputs "$T/a" "$T/c"
 
-# 4. APR: two levels split by criterion 3 during the run (the split particles' ids,
+# 3. APR: two levels split by criterion 3 during the run (the split particles' ids,
 #    sizes and masses come back from the checkpoint, the pattern search from the state)
 APR=(--set particles.dx=0.00584 --set time.end=0.3 --set time.output_every=0.03
   --set refinement.levels=2 --set refinement.free_surface=true
@@ -60,7 +60,7 @@ rm -f "$T/f"/snapshot_0008.* "$T/f"/snapshot_0009.* "$T/f"/snapshot_0010.*
 expect 0 "APR: resume after a crash" -- "$RHOD" resume "$T/f"
 check "APR: resumed run identical to the uninterrupted one" -- same_outputs "$T/e" "$T/f"
 
-# 3. bad checkpoints: exit 10, one line naming the file and the reason
+# 4. bad checkpoints: exit 10, one line naming the file and the reason
 cp -r "$T/a" "$T/d"
 printf 'X' | dd of="$T/d/checkpoint.rhod" bs=1 seek=5000 conv=notrunc 2>/dev/null
 expect 10 "corrupted checkpoint" -- "$RHOD" resume "$T/d"
