@@ -1,7 +1,8 @@
-/* Adaptive particle refinement, paper 002 Sec. V: criteria (V B) and the 1 -> 4
- * split (V A). Both are per-particle loops that write only particle i's own entries
- * (the children of i go to slots reserved for i by a scan), so they run on the
- * device like every other kernel. */
+/* Adaptive particle refinement, paper 002 Sec. V: criteria (V B), the 1 -> 4 split
+ * (V A) and its inverse, coalescing (ours, after paper 004 Sec. 2.3). All are
+ * per-particle loops that write only particle i's own entries (the children of i go
+ * to slots reserved for i by a scan; a merged group is written by its leader), so
+ * they run on the device like every other kernel. */
 #include "kernel.h"
 #include "rhod/apr.h"
 #include "rhod/device.h"
@@ -10,6 +11,22 @@
 
 /* Relative tolerance when comparing sizes: sizes are dx / 2^l, equal up to rounding. */
 #define SIZE_TOL ((real)1e-3)
+
+/* Coalescing (our choices, docs/choices.md "APR coalescing"). A particle of size dx_i
+ * is a candidate when the particle of size 2 dx_i that its group would become would
+ * not be refined again: criteria 1, 2 and 5 evaluated for the support of radius
+ * 2 R_i, criteria 3 and 4 for a support HYST times wider, criterion 2 and the
+ * thresholds of 5 with the same margin (the hysteresis that keeps a particle from
+ * splitting and merging in turn). */
+#define HYST ((real)1.25)
+/* A group: the candidate and the three same-size candidates nearest to the group's
+ * running centroid, all within 2 dx_i of it; kept when none lies farther than dx_i
+ * from the centre of mass (a 2 x 2 block of a lattice: 0.71 dx_i) and no other
+ * particle j comes nearer to that centre than Q_MIN (2 dx_i + dx_j)/2, the spacing
+ * of the merged particle and j on a regular layout (0.5 of it, which is where the
+ * children of a split stand on a regular lattice too). */
+#define Q_MIN ((real)0.5)
+#define NONE ((real)1e30)
 
 int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   memset(a, 0, sizeof *a);
@@ -22,6 +39,8 @@ int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   a->above = (real)fmin(sc->field_above, 1e30);
   a->below = (real)fmax(sc->field_below, -1e30);
   a->from = (real)sc->field_from;
+  a->coalesce = sc->refine_coalesce;
+  a->dx_max = (real)sc->dx;
   return RHOD_OK;
 }
 
@@ -30,9 +49,14 @@ void rhod_apr_free(rhod_apr *a) {
   rhod_dev_free(a->near, a->cap);
   rhod_dev_free(a->cnt, (a->cap + 1) * sizeof(int32_t));
   rhod_dev_free(a->sd, 4 * a->cap * sizeof(real));
-  a->mark = a->near = NULL;
-  a->cnt = NULL;
-  a->sd = NULL;
+  rhod_dev_free(a->near2, a->cap);
+  rhod_dev_free(a->grp, 4 * a->cap * sizeof(int32_t));
+  rhod_dev_free(a->claim, a->cap * sizeof(int32_t));
+  rhod_dev_free(a->acc, a->cap);
+  rhod_dev_free(a->sp, a->cap * sizeof(real));
+  a->mark = a->near = a->near2 = a->acc = NULL;
+  a->cnt = a->grp = a->claim = NULL;
+  a->sd = a->sp = NULL;
   a->cap = 0;
 }
 
@@ -45,21 +69,34 @@ static int ensure(rhod_apr *a, size_t n) {
   a->near = rhod_dev_calloc(a->cap, 1);
   a->cnt = rhod_dev_calloc(a->cap + 1, sizeof(int32_t));
   a->sd = rhod_dev_calloc(4 * a->cap, sizeof(real));
-  return a->mark && a->near && a->cnt && a->sd ? RHOD_OK : RHOD_ERR_MEMORY;
+  a->near2 = rhod_dev_calloc(a->cap, 1);
+  a->grp = rhod_dev_calloc(4 * a->cap, sizeof(int32_t));
+  a->claim = rhod_dev_calloc(a->cap, sizeof(int32_t));
+  a->acc = rhod_dev_calloc(a->cap, 1);
+  a->sp = rhod_dev_calloc(a->cap, sizeof(real));
+  return a->mark && a->near && a->cnt && a->sd && a->near2 && a->grp && a->claim && a->acc && a->sp
+             ? RHOD_OK
+             : RHOD_ERR_MEMORY;
 }
 
+static void group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c);
+
 int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const rhod_cells *c,
-                  const rhod_boundary *b, double t) {
+                  const rhod_boundary *b, double t, int coalesce) {
   const long n = (long)p->n;
   if (ensure(a, p->n) != RHOD_OK)
     return RHOD_ERR_MEMORY;
+  a->n_marked = n;
+  const int co = coalesce && a->coalesce;
   if (a->walls)
     rhod_walls_near(b, p, s->ratio, a->near);
+  if (a->walls && co)
+    rhod_walls_near(b, p, 2 * HYST * s->ratio, a->near2);
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
   const real *x = p->x, *y = p->y, *dx = p->dx, *ux = p->ux, *uy = p->uy, *rho = p->rho;
   const real *V = s->V, *P = s->P, *gP = s->gP;
-  const uint8_t *reg = s->reg, *near = a->near;
+  const uint8_t *reg = s->reg, *near = a->near, *near2 = a->near2, *cmark = c->mark;
   uint8_t *mark = a->mark;
   real *sd = a->sd;
   const int kern = s->kernel;
@@ -67,12 +104,18 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const int c3 = a->free_surface && s->fsdetect, c4 = a->walls;
   const int c5 = a->field && (real)t >= a->from, dyn = a->qty == RHOD_QTY_DYNAMIC_PRESSURE;
   const real above = a->above, below = a->below;
-  RHOD_KERNEL_LOOP
+  /* coalescing: the largest size that may merge, the thresholds of criterion 5 with
+   * the margin (HYST - 1) |threshold| (1e30 stands for none and stays far away) */
+  const real dgrow = (real)0.5 * a->dx_max * (1 + SIZE_TOL);
+  const real above2 = above - (HYST - 1) * fabs(above), below2 = below + (HYST - 1) * fabs(below);
+  long ncand = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, ncand)
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], dxi = dx[i], Ri = ratio * dxi, R2 = Ri * Ri;
     sd[4 * i] = gP[2 * i], sd[4 * i + 1] = gP[2 * i + 1];
     sd[4 * i + 2] = 1, sd[4 * i + 3] = 0;
-    if ((real)0.5 * dxi < dmin) { /* dx_min is never crossed (Sec. V B) */
+    const int can_split = (real)0.5 * dxi >= dmin; /* dx_min is never crossed (Sec. V B) */
+    if (!can_split && !(co && dxi <= dgrow)) {
       mark[i] = 0;
       continue;
     }
@@ -101,9 +144,45 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     RHOD_END_NEIGHBOURS
     const real phi = num / den;
-    const int m = grand || same < 2 * self || (c3 && reg[i] != 0) || (c4 && near[i]) ||
-                  (c5 && (phi > above || phi < below));
+    const int m = can_split && (grand || same < 2 * self || (c3 && reg[i] != 0) ||
+                                (c4 && near[i]) || (c5 && (phi > above || phi < below)));
     mark[i] = (uint8_t)m;
+    if (!m && co && dxi <= dgrow && !(c3 && reg[i] != 0) && !(c4 && near2[i])) {
+      /* Coalescing candidate: the criteria for the particle of size D = 2 dx_i at x_i
+       * (HYST above). Criterion 3 first from the per-cell free-surface flags of the
+       * region pass (conservative: whole cells), then one pass over the support 2 R_i:
+       * no particle of size dx_i/2 or less (criterion 1: it would be D/4), the sum of
+       * Gamma over sizes >= D at least (2 HYST - 1) Gamma_DD with the merged volume
+       * 4 V_i (criterion 2 with margin), and the Shepard field inside the thresholds
+       * with margin (criterion 5). */
+      const real RD = 2 * Ri, RD2 = RD * RD, iRD = 1 / RD, iRD2 = iRD * iRD;
+      int ok = !(c3 && rhod_cells_near_mark(G, cmark, xi, yi, HYST * RD));
+      if (ok) {
+        const real self2 = rhod_Wq(kern, 0) * iRD2 * 4 * V[i],
+                   half = (real)0.5 * dxi * (1 + SIZE_TOL);
+        const real big = 2 * dxi * (1 - SIZE_TOL);
+        real same2 = 0, num2 = self2 * phii, den2 = self2;
+        int fine = 0;
+        RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RD, j) {
+          const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+          if (r2 < RD2 && j != i) {
+            const real dxj = dx[j];
+            fine |= dxj <= half;
+            const real w = rhod_Wq(kern, sqrt(r2) * iRD) * iRD2 * V[j];
+            same2 += dxj >= big ? w : 0;
+            if (c5) {
+              const real phij = dyn ? (real)0.5 * rho[j] * (ux[j] * ux[j] + uy[j] * uy[j]) : P[j];
+              num2 += w * phij, den2 += w;
+            }
+          }
+        }
+        RHOD_END_NEIGHBOURS
+        const real phi2 = num2 / den2;
+        ok = !fine && same2 >= (2 * HYST - 1) * self2 && !(c5 && (phi2 > above2 || phi2 < below2));
+      }
+      mark[i] = ok ? 2 : 0;
+      ncand += ok;
+    }
     if (!m || !(best < R2))
       continue;
     /* Pattern of the children (Sec. V A, Fig. 5). The paper turns the square of side
@@ -158,7 +237,125 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     sd[4 * i + 2] = bx, sd[4 * i + 3] = by; /* e scaled by the aspect a */
   }
+  if (ncand >= 4)
+    group(a, p, c);
   return RHOD_OK;
+}
+
+/* Groups of four candidates (mark 2), formed at the marking positions in rounds: each
+ * candidate left proposes one (Q_MIN above), each candidate takes the proposal
+ * containing it with the smallest spread (ties: the lower index), and a proposal whose
+ * four members all took it is accepted: leader mark 3, members 4. On a lattice every
+ * spread ties and overlapping proposals block each other, so one round accepts few;
+ * GROUP_ROUNDS rounds (or until one accepts none), then the candidates left go back
+ * to 0 and may group at a later marking. Every pass writes only its own particle's
+ * entries. */
+#define GROUP_ROUNDS 6
+static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *c);
+
+static void group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c) {
+  for (int r = 0; r < GROUP_ROUNDS && group_round(a, p, c) > 0; r++)
+    ;
+  const long n = (long)p->n;
+  uint8_t *mark = a->mark;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++)
+    mark[i] = mark[i] == 2 ? 0 : mark[i];
+}
+
+static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *m = p->m;
+  uint8_t *mark = a->mark, *acc = a->acc;
+  int32_t *grp = a->grp, *claim = a->claim;
+  real *sp = a->sp;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    sp[i] = NONE;
+    if (mark[i] != 2)
+      continue;
+    const real xi = x[i], yi = y[i], dxi = dx[i], reach = 2 * dxi, reach2 = reach * reach;
+    const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
+    int32_t g1 = -1, g2 = -1, g3 = -1;
+    real cx = xi, cy = yi;
+    for (int r = 0; r < 3; r++) {
+      real bd = reach2;
+      int32_t bj = -1;
+      RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
+        if (j < n && j != i && j != g1 && j != g2 && mark[j] == 2 && dx[j] > lo && dx[j] < hi) {
+          const real rx = x[j] - cx, ry = y[j] - cy, d2 = rx * rx + ry * ry;
+          if (d2 < bd || (d2 == bd && j < bj))
+            bd = d2, bj = j;
+        }
+      }
+      RHOD_END_NEIGHBOURS
+      if (bj < 0)
+        break;
+      g1 = r == 0 ? bj : g1, g2 = r == 1 ? bj : g2, g3 = r == 2 ? bj : g3;
+      cx += (x[bj] - cx) / (r + 2), cy += (y[bj] - cy) / (r + 2);
+    }
+    if (g3 < 0)
+      continue;
+    /* centre of mass and spread */
+    const real M = m[i] + m[g1] + m[g2] + m[g3];
+    const real X = (m[i] * xi + m[g1] * x[g1] + m[g2] * x[g2] + m[g3] * x[g3]) / M;
+    const real Y = (m[i] * yi + m[g1] * y[g1] + m[g2] * y[g2] + m[g3] * y[g3]) / M;
+    real s2 = (xi - X) * (xi - X) + (yi - Y) * (yi - Y);
+    real d = (x[g1] - X) * (x[g1] - X) + (y[g1] - Y) * (y[g1] - Y);
+    s2 = d > s2 ? d : s2;
+    d = (x[g2] - X) * (x[g2] - X) + (y[g2] - Y) * (y[g2] - Y);
+    s2 = d > s2 ? d : s2;
+    d = (x[g3] - X) * (x[g3] - X) + (y[g3] - Y) * (y[g3] - Y);
+    s2 = d > s2 ? d : s2;
+    if (s2 > dxi * dxi)
+      continue;
+    /* room around the merged particle (ghosts included, so walls count) */
+    int room = 1;
+    const real look = 3 * dxi;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, X, Y, look, j) {
+      if (j != i && j != g1 && j != g2 && j != g3) {
+        const real rx = x[j] - X, ry = y[j] - Y, q = Q_MIN * (dxi + (real)0.5 * dx[j]);
+        room &= rx * rx + ry * ry >= q * q;
+      }
+    }
+    RHOD_END_NEIGHBOURS
+    if (!room)
+      continue;
+    grp[4 * i] = (int32_t)i, grp[4 * i + 1] = g1, grp[4 * i + 2] = g2, grp[4 * i + 3] = g3;
+    sp[i] = s2;
+  }
+  RHOD_KERNEL_LOOP
+  for (long j = 0; j < n; j++) {
+    claim[j] = -1;
+    if (mark[j] != 2)
+      continue;
+    const real reach = 2 * dx[j] * (1 + SIZE_TOL);
+    real bs = NONE;
+    int32_t bi = -1;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, x[j], y[j], reach, i) {
+      if (i < n && sp[i] < NONE &&
+          (grp[4 * i] == j || grp[4 * i + 1] == j || grp[4 * i + 2] == j || grp[4 * i + 3] == j) &&
+          (sp[i] < bs || (sp[i] == bs && i < bi)))
+        bs = sp[i], bi = i;
+    }
+    RHOD_END_NEIGHBOURS
+    claim[j] = bi;
+  }
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++)
+    acc[i] = sp[i] < NONE && claim[grp[4 * i]] == i && claim[grp[4 * i + 1]] == i &&
+             claim[grp[4 * i + 2]] == i && claim[grp[4 * i + 3]] == i;
+  long accepted = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, accepted)
+  for (long j = 0; j < n; j++)
+    if (mark[j] == 2) {
+      const int32_t k = claim[j];
+      mark[j] = k >= 0 && acc[k] ? (k == j ? 3 : 4) : 2;
+      accepted += k == j && acc[k];
+    }
+  return accepted;
 }
 
 long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rhod_boundary *b) {
@@ -170,7 +367,7 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   int32_t *cnt = a->cnt;
   RHOD_KERNEL_LOOP
   for (long i = 0; i <= n; i++)
-    cnt[i] = i < n && mark[i] ? 3 : 0;
+    cnt[i] = i < n && mark[i] == 1 ? 3 : 0;
   const long added = rhod_scan_exclusive(cnt, (size_t)n + 1);
   if (added <= 0)
     return added;
@@ -179,7 +376,7 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   int32_t *src = p->perm;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++)
-    if (mark[i])
+    if (mark[i] == 1)
       for (int k = 0; k < 3; k++)
         src[cnt[i] + k] = (int32_t)i;
   /* velocity (u_child = u_i, Sec. V A) and every other persistent array come along */
@@ -193,7 +390,7 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   const int nseg = b->nseg, ncirc = b->ncirc;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
-    if (!mark[i])
+    if (mark[i] != 1)
       continue;
     const real xi = x[i], yi = y[i], dxi = dx[i], mi = m[i];
     const real Pi = c2 * (rho[i] - rho0); /* Eq. 2 */
@@ -233,4 +430,59 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   a->split_last = added / 3;
   a->split_total += added / 3;
   return added / 3;
+}
+
+long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
+  const long n = (long)p->n, nm = a->n_marked;
+  a->merged_last = 0;
+  if (!a->coalesce || !a->mark || nm > n)
+    return 0;
+  const uint8_t *mark = a->mark;
+  const int32_t *grp = a->grp;
+  int32_t *cnt = a->cnt;
+  real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *m = p->m, *dx = p->dx;
+  long groups = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, groups)
+  for (long i = 0; i <= nm; i++) {
+    cnt[i] = i < nm && mark[i] != 4;
+    groups += i < nm && mark[i] == 3;
+  }
+  if (groups == 0)
+    return 0;
+  /* The merged particle, in the leader's slot (our choice, docs/choices.md): mass
+   * m = sum m_k; position and velocity the mass-weighted means (centre of mass and
+   * momentum conserved, as in paper 004 Sec. 2.3); volume V = sum m_k / rho_k
+   * conserved, so rho = m / V (the inverse of the split's V_c = (V_i rho_i / 4) /
+   * rho_c); size 2 dx_k; the leader's id. The kinetic energy of the members' motion
+   * about their mean is lost (a dissipation the energy probes see). */
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < nm; i++) {
+    if (mark[i] != 3)
+      continue;
+    real M = 0, X = 0, Y = 0, U = 0, W = 0, V = 0;
+    for (int k = 0; k < 4; k++) {
+      const int32_t j = grp[4 * i + k];
+      const real mj = m[j];
+      M += mj, X += mj * x[j], Y += mj * y[j], U += mj * ux[j], W += mj * uy[j];
+      V += mj / rho[j];
+    }
+    x[i] = X / M, y[i] = Y / M, ux[i] = U / M, uy[i] = W / M;
+    m[i] = M, rho[i] = M / V, dx[i] = 2 * dx[i];
+  }
+  const long kept = rhod_scan_exclusive(cnt, (size_t)nm + 1);
+  int32_t *perm = p->perm;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < nm; i++)
+    if (mark[i] != 4)
+      perm[cnt[i]] = (int32_t)i;
+  /* the children of this step's split stay behind, in order */
+  RHOD_KERNEL_LOOP
+  for (long t = nm; t < n; t++)
+    perm[kept + t - nm] = (int32_t)t;
+  p->n = (size_t)(kept + n - nm);
+  p->ng = 0;
+  rhod_particles_permute(p);
+  a->merged_last = groups;
+  a->merged_total += groups;
+  return groups;
 }

@@ -152,7 +152,7 @@ typedef struct {
   double *levels;
   y_region *regions;
   unsigned n_regions;
-  bool *dynamic, *free_surface, *walls;
+  bool *dynamic, *free_surface, *walls, *coalesce;
   y_refine_field *field;
 } y_refinement;
 
@@ -413,6 +413,7 @@ static const cyaml_schema_field_t f_refinement[] = {
     BOOL_OPT("dynamic", y_refinement, dynamic),
     BOOL_OPT("free_surface", y_refinement, free_surface),
     BOOL_OPT("walls", y_refinement, walls),
+    BOOL_OPT("coalesce", y_refinement, coalesce),
     CYAML_FIELD_MAPPING_PTR("field", OPT | CYAML_FLAG_FLOW, y_refinement, field, f_refine_field),
     CYAML_FIELD_END,
 };
@@ -1236,6 +1237,7 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
   s->refine_dynamic = s->levels > 1 && opt_bool(r ? r->dynamic : NULL, 1);
   s->refine_free_surface = opt_bool(r ? r->free_surface : NULL, 0);
   s->refine_walls = opt_bool(r ? r->walls : NULL, 0);
+  s->refine_coalesce = opt_bool(r ? r->coalesce : NULL, 0);
   if (r && r->n_regions) {
     s->regions = calloc(r->n_regions, sizeof *s->regions);
     if (!s->regions)
@@ -1270,6 +1272,9 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
   if (s->refine_free_surface && !s->free_surface)
     return fail(c, "refinement.free_surface",
                 "criterion 3 needs the free-surface detection (scheme.free_surface: true)");
+  if (s->refine_coalesce && !s->refine_dynamic)
+    return fail(c, "refinement.coalesce",
+                "needs dynamic refinement (refinement.dynamic: true and levels >= 2)");
   const int any = s->refine_free_surface || s->refine_walls || s->refine_field;
   if (s->levels == 1 && (any || s->n_regions))
     return fail(c, "refinement.levels",
@@ -1739,6 +1744,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_bool(&t, m, "dynamic", s->refine_dynamic);
   tb_bool(&t, m, "free_surface", s->refine_free_surface);
   tb_bool(&t, m, "walls", s->refine_walls);
+  tb_bool(&t, m, "coalesce", s->refine_coalesce);
   if (s->refine_field) {
     e = tb_coll(&t, m, "field", RY_MAP, 1);
     tb_word(&t, e, "quantity",

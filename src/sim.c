@@ -345,7 +345,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
    * naturally ensure the criteria") instead of splitting in cascade once it moves. */
   for (int round = 1; round < sc->levels; round++) {
     rhod_sph_rhs(&s->sph, p, &s->cells, (real)s->dt);
-    st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, 0);
+    st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, 0, 0);
     const long split = st == RHOD_OK ? rhod_apr_split(&s->apr, &s->sph, p, &s->bnd) : -1;
     if (split < 0) {
       snprintf(err, errlen, "out of memory refining the initial particles");
@@ -488,7 +488,10 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
     rhod_sph_rhs(&s->sph, p, &s->cells, (real)dt);
     /* refinement criteria during the last stage (paper 002 Sec. V) */
     if (s->apr.active && stage == s->rk.stages - 1) {
-      st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, s->t + dt);
+      /* coalescing is looked for every RHOD_COALESCE_EVERY steps: its candidate
+       * test gathers over twice the support (docs/choices.md "APR coalescing") */
+      const int co = s->step % RHOD_COALESCE_EVERY == 0;
+      st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, s->t + dt, co);
       if (st != RHOD_OK)
         goto mem;
     }
@@ -507,7 +510,8 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
     st = RHOD_ERR_MEMORY;
     goto mem;
   }
-  if (s->apr.split_last > 0)
+  rhod_apr_coalesce(&s->apr, p);
+  if (s->apr.split_last > 0 || s->apr.merged_last > 0)
     s->dt = rhod_sph_dt(&s->sph, p);
   return RHOD_OK;
 mem:

@@ -236,7 +236,7 @@ static int ids_unique(const rhod_snapshot_view *v, uint64_t next_id) {
 static long split_round(run *r) {
   rhod_sim *s = r->sim;
   rhod_sph_rhs(&s->sph, &s->p, &s->cells, (real)s->dt);
-  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&s->apr, &s->sph, &s->p, &s->cells, &s->bnd, 0), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&s->apr, &s->sph, &s->p, &s->cells, &s->bnd, 0, 0), RHOD_OK);
   return rhod_apr_split(&s->apr, &s->sph, &s->p, &s->bnd);
 }
 
@@ -412,7 +412,7 @@ static void mark_store(rhod_scene *sc, rhod_particles *p, rhod_sph *s, rhod_cell
   rhod_boundary bnd;
   memset(&bnd, 0, sizeof bnd);
   CU_ASSERT_EQUAL_FATAL(rhod_apr_init(a, sc, dx_min), RHOD_OK);
-  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(a, s, p, c, &bnd, 0), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(a, s, p, c, &bnd, 0, 0), RHOD_OK);
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -737,6 +737,170 @@ static void test_criteria_1_2(void) {
 }
 
 /* ------------------------------------------------------------------------------------ */
+/* 7. coalescing: groups on a hand-made store, then whole runs                           */
+
+/* A fine lattice (dx/2, 24 x 24) beside a coarse one (dx, 8 x 12), a linear velocity
+ * field and a pressure gradient. Coalescing with criteria 1 and 2 only: candidates
+ * are the fine particles near the coarse block (criterion 2 for the merged particle
+ * needs coarse neighbours), groups are the lattice's 2 x 2 blocks, and the merge
+ * keeps mass, momentum, centre of mass and volume. */
+static void test_coalesce_groups(void) {
+  const double dx = 0.01, h = dx / 2, c0 = 20, rho0 = 1000;
+  rhod_scene *sc = unit_scene(dx);
+  sc->refine_coalesce = 1;
+  rhod_particles p;
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, 800), RHOD_OK);
+  unsigned long seed = 5;
+  add_block(&p, 0, 0, 24, 24, h, 0, &seed);       /* x in [0, 12 dx) */
+  add_block(&p, 12 * dx, 0, 8, 12, dx, 0, &seed); /* x in [12, 20) dx */
+  const long n0 = (long)p.n;
+  for (long i = 0; i < n0; i++) {
+    p.ux[i] = (real)(0.3 + 5 * p.y[i]), p.uy[i] = (real)(-0.1 + 7 * p.x[i]);
+    p.rho[i] = (real)(rho0 + (2000 * p.x[i] - 800 * p.y[i]) / (c0 * c0));
+    p.m[i] = (real)(rho0 * p.dx[i] * p.dx[i]); /* rho differs: volumes m/rho differ */
+    p.id[i] = (uint64_t)i;
+  }
+  double M0 = 0, PX0 = 0, PY0 = 0, X0 = 0, Y0 = 0, V0 = 0;
+  for (long i = 0; i < n0; i++) {
+    M0 += p.m[i], PX0 += p.m[i] * p.ux[i], PY0 += p.m[i] * p.uy[i];
+    X0 += p.m[i] * p.x[i], Y0 += p.m[i] * p.y[i], V0 += p.m[i] / p.rho[i];
+  }
+  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {28 * dx, 20 * dx};
+  rhod_sph s;
+  rhod_cells c;
+  rhod_apr a;
+  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
+  rhod_boundary nowalls;
+  memset(&nowalls, 0, sizeof nowalls);
+  /* again with coalescing (mark_store marked without) */
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&a, &s, &p, &c, &nowalls, 0, 1), RHOD_OK);
+  rhod_to_host(a.mark, (size_t)n0);
+  rhod_to_host(a.grp, 4 * (size_t)n0 * sizeof(int32_t));
+  long leaders = 0, members = 0, coarse_marked = 0, bad_group = 0, far = 0, split = 0;
+  int *owner = calloc((size_t)n0, sizeof *owner);
+  for (long i = 0; i < n0; i++) {
+    coarse_marked += p.dx[i] == (real)dx && a.mark[i] > 1;
+    split += a.mark[i] == 1;
+    members += a.mark[i] == 4;
+    far += a.mark[i] >= 2 && p.x[i] < 12 * dx - 8 * h; /* 2 R of a fine one from the coarse */
+    if (a.mark[i] != 3)
+      continue;
+    leaders++;
+    /* a 2 x 2 block of the lattice: 4 distinct fine particles, 0.71 h from their centre */
+    double cx = 0, cy = 0;
+    for (int k = 0; k < 4; k++) {
+      const int32_t j = a.grp[4 * i + k];
+      cx += 0.25 * p.x[j], cy += 0.25 * p.y[j];
+      bad_group += p.dx[j] != (real)h || (k > 0 && a.mark[j] != 4) || owner[j]++ > 0;
+    }
+    for (int k = 0; k < 4; k++) {
+      const int32_t j = a.grp[4 * i + k];
+      bad_group += fabs(hypot(p.x[j] - cx, p.y[j] - cy) - h * 0.70710678118654752) > TOL(1e-9) * h;
+    }
+  }
+  printf("\ncoalescing: %ld groups of the %d fine particles\n", leaders, 24 * 24);
+  CU_ASSERT(leaders >= 6); /* 8: the two fine columns next to the coarse block, 44 candidates */
+  CU_ASSERT_EQUAL(members, 3 * leaders);
+  CU_ASSERT_EQUAL(bad_group, 0);
+  CU_ASSERT_EQUAL(coarse_marked, 0); /* dx is the coarsest size */
+  CU_ASSERT_EQUAL(far, 0);
+  CU_ASSERT_EQUAL(split, 0);
+  CU_ASSERT_EQUAL(rhod_apr_split(&a, &s, &p, &nowalls), 0);
+  CU_ASSERT_EQUAL(rhod_apr_coalesce(&a, &p), leaders);
+  rhod_particles_to_host(&p);
+  CU_ASSERT_EQUAL((long)p.n, n0 - 3 * leaders);
+  double M1 = 0, PX1 = 0, PY1 = 0, X1 = 0, Y1 = 0, V1 = 0;
+  long grown = 0, gone = 0;
+  for (long i = 0; i < (long)p.n; i++) {
+    M1 += p.m[i], PX1 += p.m[i] * p.ux[i], PY1 += p.m[i] * p.uy[i];
+    X1 += p.m[i] * p.x[i], Y1 += p.m[i] * p.y[i], V1 += p.m[i] / p.rho[i];
+    grown += p.dx[i] == (real)dx && p.x[i] < 12 * dx;
+    gone += a.mark[p.id[i]] == 4; /* the store is unsorted here: id = old index */
+  }
+  CU_ASSERT_EQUAL(grown, leaders);
+  CU_ASSERT_EQUAL(gone, 0);
+  CU_ASSERT(fabs(M1 - M0) <= TOL(1e-14) * M0);
+  CU_ASSERT(fabs(PX1 - PX0) <= TOL(1e-13) * M0);
+  CU_ASSERT(fabs(PY1 - PY0) <= TOL(1e-13) * M0);
+  CU_ASSERT(fabs(X1 - X0) <= TOL(1e-13) * M0 * 20 * dx);
+  CU_ASSERT(fabs(Y1 - Y0) <= TOL(1e-13) * M0 * 20 * dx);
+  CU_ASSERT(fabs(V1 - V0) <= TOL(1e-13) * V0);
+  /* ids: the leaders' kept, the members' gone, all distinct */
+  rhod_snapshot_view v = {.n = p.n, .id = p.id};
+  CU_ASSERT(ids_unique(&v, p.next_id));
+  free(owner);
+  rhod_apr_free(&a);
+  rhod_cells_free(&c);
+  rhod_particles_free(&p);
+  free(sc);
+}
+
+/* A tank at rest with a refined block (level 1) in the bulk and no criterion asking
+ * for it: with coalescing the block merges back from its edges (the merged particle
+ * needs coarse neighbours, criterion 2 with margin), no merged particle is split
+ * again, and mass stays. Without coalescing nothing changes. With criterion 3 the
+ * free-surface band made at t = 0 stays (hysteresis). */
+#define REST_TANK(extra)                                                                           \
+  "time: {end: 1, output_every: 1}\n"                                                              \
+  "particles: {dx: 0.01}\n"                                                                        \
+  "physics: {c0: 10, gravity: [0, -9.81]}\n"                                                       \
+  "fluid:\n"                                                                                       \
+  "  - rect: {min: [0, 0], max: [0.3, 0.12]}\n"                                                    \
+  "    pressure: hydrostatic\n"                                                                    \
+  "walls:\n"                                                                                       \
+  "  - rect: {min: [0, 0], max: [0.3, 0.2]}\n"                                                     \
+  "refinement:\n"                                                                                  \
+  "  levels: 2\n" extra
+
+static long count_fine(const rhod_snapshot_view *v, double dx) {
+  long k = 0;
+  for (size_t i = 0; i < v->n; i++)
+    k += v->size[i] < (real)(0.75 * dx);
+  return k;
+}
+
+static void test_coalesce_run(void) {
+  const char *kinds[3] = {
+      REST_TANK("  coalesce: true\n"
+                "  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n"),
+      REST_TANK("  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n"),
+      REST_TANK("  coalesce: true\n  free_surface: true\n")};
+  for (int k = 0; k < 3; k++) {
+    run r;
+    char tag[32];
+    snprintf(tag, sizeof tag, "rest%d", k);
+    CU_ASSERT_FATAL(run_open(&r, tag, kinds[k]));
+    rhod_snapshot_view v;
+    rhod_sim_fetch(r.sim, &v);
+    const long n0 = (long)v.n, fine0 = count_fine(&v, 0.01);
+    const long double m0 = fluid_totals(&v).m;
+    char err[512] = "";
+    long fine = fine0, grew = 0;
+    for (int step = 0; step < 41; step++) {
+      CU_ASSERT_EQUAL_FATAL(rhod_sim_step(r.sim, r.sim->dt, err, sizeof err), RHOD_OK);
+      rhod_sim_fetch(r.sim, &v);
+      const long f = count_fine(&v, 0.01);
+      grew += f > fine;
+      fine = f;
+    }
+    const long double m1 = fluid_totals(&v).m;
+    printf("\n%s: fine particles %ld -> %ld, particles %ld -> %zu, %ld groups merged", tag, fine0,
+           fine, n0, v.n, r.sim->apr.merged_total);
+    CU_ASSERT(fine0 > 0);
+    CU_ASSERT_EQUAL(grew, 0);
+    CU_ASSERT_EQUAL(r.sim->apr.split_total, 0);
+    CU_ASSERT(fabsl(m1 - m0) <= TOL(1e-13) * m0);
+    CU_ASSERT_EQUAL((long)v.n, n0 - 3 * r.sim->apr.merged_total);
+    if (k == 0) {
+      CU_ASSERT(fine <= fine0 / 2); /* five searches (steps 0, 10, ..., 40) */
+    } else {
+      CU_ASSERT_EQUAL(fine, fine0);
+    }
+    run_close(&r);
+  }
+}
+
+/* ------------------------------------------------------------------------------------ */
 /* 6. refinement.levels: 2 without any split is the single-resolution run                */
 
 /* A column of water (fluid_rect, 20 x 20 particles) collapsing in a tank. */
@@ -849,6 +1013,8 @@ int main(void) {
       {"split children are kept off the walls", test_split_keeps_off_walls},
       {"dx_min is never crossed", test_dx_min_never_crossed},
       {"criteria 1 and 2", test_criteria_1_2},
+      {"coalescing groups and conservation", test_coalesce_groups},
+      {"coalescing in a run: merges back, never splits again", test_coalesce_run},
       {"snapshot free-surface flags, across levels and splits", test_free_surface_flags},
       {"levels 2 without splits = single resolution", test_equal_sizes_single_resolution},
       {"... also in a corner of the tank", test_equal_sizes_single_resolution_corner},

@@ -1,7 +1,13 @@
 /* Adaptive particle refinement of paper 002 (Michel et al. 2025), Sec. V: the
  * refinement criteria (Sec. V B), evaluated during the last stage of a step, and the
  * 1 -> 4 split (Sec. V A) applied before the next one: mark, scan, append, then the
- * engine re-sorts at the next step. Sizes are particles.dx / 2^l, l < levels. */
+ * engine re-sorts at the next step. Sizes are particles.dx / 2^l, l < levels.
+ *
+ * Coalescing (not in paper 002, which leaves it to future work; paper 004 Sec. 2.3
+ * merges the nearest small particles at their centre of mass): four particles of a
+ * level where no criterion would refine their parent any more merge back into one of
+ * twice their size, conserving mass, momentum and volume. Marked in the same pass
+ * (candidates, then groups), applied after the split: combine, scan, compact. */
 #ifndef RHOD_APR_H
 #define RHOD_APR_H
 
@@ -19,14 +25,24 @@ typedef struct {
   int field;        /* criterion 5 */
   rhod_quantity qty;
   real above, below, from;
+  int coalesce; /* refinement.coalesce */
+  real dx_max;  /* no particle grows beyond this size (particles.dx) */
   /* Own buffers, not fields of the store: they must survive the store's growth
    * between marking and splitting. */
   size_t cap;
-  uint8_t *mark; /* cap: 1 = split at the end of the step */
-  uint8_t *near; /* cap: criterion 4 (support reaches a wall) */
-  int32_t *cnt;  /* cap + 1: children written per particle, scanned */
-  real *sd;      /* 4 cap: split data: grad P (Eq. 14), unit vector to the nearest neighbour */
-  long split_last, split_total; /* particles split by the last call and by the run */
+  uint8_t *mark;  /* cap: 1 = split at the end of the step; coalescing: 2 candidate,
+                     3 merges its group into itself, 4 merged into another */
+  uint8_t *near;  /* cap: criterion 4 (support reaches a wall) */
+  int32_t *cnt;   /* cap + 1: children written per particle, scanned */
+  real *sd;       /* 4 cap: split data: grad P (Eq. 14), unit vector to the nearest neighbour */
+  uint8_t *near2; /* cap: criterion 4 for the coalesced particle (wider support) */
+  int32_t *grp;   /* 4 cap: the group a candidate proposes (itself first) */
+  int32_t *claim; /* cap: the winning group containing a candidate, or -1 */
+  uint8_t *acc;   /* cap: 1 = the candidate's proposed group was accepted */
+  real *sp;       /* cap: the proposal's spread (smaller wins), or 1e30 for none */
+  long n_marked;  /* fluid particles when marked (coalescing indices are below it) */
+  long split_last, split_total;   /* particles split by the last call and by the run */
+  long merged_last, merged_total; /* groups coalesced by the last call and by the run */
 } rhod_apr;
 
 int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min);
@@ -34,13 +50,19 @@ void rhod_apr_free(rhod_apr *a);
 
 /* Criteria 1-5 for every fluid particle, from the neighbour structure and the
  * scheme's fields of the right-hand side just computed (call it after the last
- * stage's rhod_sph_rhs, before the update). Time t gates criterion 5. */
+ * stage's rhod_sph_rhs, before the update). Time t gates criterion 5. With coalesce
+ * (and a->coalesce) it also forms the groups that rhod_apr_coalesce merges. */
 int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const rhod_cells *c,
-                  const rhod_boundary *b, double t);
+                  const rhod_boundary *b, double t, int coalesce);
 
 /* Splits the marked fluid particles (Sec. V A) at their current state; returns how
  * many were split, or < 0 when memory ran out. Children are kept off the walls of b
- * (half their size). Ghosts and cells are stale after it. */
+ * (a quarter of their size). Ghosts and cells are stale after it. */
 long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rhod_boundary *b);
+
+/* Merges the groups formed by the last rhod_apr_mark (call it after rhod_apr_split,
+ * whose children it keeps) and removes the merged particles; returns the number of
+ * groups merged. Ghosts and cells are stale after it. */
+long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p);
 
 #endif

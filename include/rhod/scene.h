@@ -163,6 +163,8 @@ typedef struct {
   int refine_free_surface;         /* refinement.free_surface: criterion 3, default false */
   int refine_walls;                /* refinement.walls: criterion 4, default false */
   int refine_field;                /* refinement.field given: criterion 5 */
+  int refine_coalesce;             /* refinement.coalesce: merge back where no criterion
+                                      holds any more, default false */
   rhod_quantity field_quantity;    /* refinement.field.quantity */
   double field_above, field_below; /* thresholds (+-HUGE_VAL when absent) */
   double field_from;               /* refinement.field.from [s], default 0 */

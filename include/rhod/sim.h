@@ -12,6 +12,9 @@
 #include "rhod/scene.h"
 #include "rhod/sph.h"
 
+/* Steps between two searches for coalescing groups (refinement.coalesce). */
+#define RHOD_COALESCE_EVERY 10
+
 typedef struct {
   const rhod_scene *sc;
   rhod_particles p;
