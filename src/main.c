@@ -198,10 +198,12 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
                         "  \"dt\": %.9g,\n  \"wall_seconds\": %.6g,\n"
                         "  \"us_per_particle_step\": %.6g,\n  \"precision\": \"%s\",\n"
                         "  \"threads\": %d,\n  \"kernels_ran_on\": \"%s\",\n"
-                        "  \"wall_reflections\": %ld,\n  \"probes\": {",
+                        "  \"wall_reflections\": %ld,\n  \"splits\": %ld,\n  \"merges\": %ld,\n"
+                        "  \"probes\": {",
                         status, cause, c->sc->path, s->p.n, s->step, s->t, s->dt, wall,
                         psteps > 0 ? 1e6 * wall / psteps : 0.0, RHOD_REAL_NAME,
-                        omp_get_max_threads(), c->where, s->reflected);
+                        omp_get_max_threads(), c->where, s->reflected, s->apr.split_total,
+                        s->apr.merged_total);
   for (unsigned k = 0; k < c->nprobe_cols && o < sizeof buf - 200; k++)
     o += (size_t)snprintf(buf + o, sizeof buf - o, "%s\n    \"%s\": %.9g", k ? "," : "",
                           c->probe_names[k], c->probe_vals ? c->probe_vals[k] : 0.0);
@@ -493,9 +495,10 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     const double psteps = s->particle_steps;
     logline("rhod: done: %ld steps, %.3f s wall, %.4g us per particle-step", s->step, wall,
             psteps > 0 ? 1e6 * wall / psteps : 0.0);
-    if (s->apr.split_total)
-      logline("rhod: %ld particles split by the refinement criteria during the run (%zu now)",
-              s->apr.split_total, s->p.n);
+    if (s->apr.split_total || s->apr.merged_total)
+      logline("rhod: %ld particles split by the refinement criteria and %ld groups of four "
+              "coalesced during the run (%zu particles now)",
+              s->apr.split_total, s->apr.merged_total, s->p.n);
     if (s->reflected)
       logline("rhod: %ld particle-steps ended just behind a wall and were reflected back "
               "(docs/choices.md)",
