@@ -17,7 +17,8 @@
  * not be refined again: criteria 1, 2 and 5 evaluated for the support of radius
  * 2 R_i, criteria 3 and 4 for a support HYST times wider, criterion 2 and the
  * thresholds of 5 with the same margin (the hysteresis that keeps a particle from
- * splitting and merging in turn). */
+ * splitting and merging in turn). Criterion 2 counts the other candidates as the
+ * merged particles they will mostly become (coalesce_c2). */
 #define HYST ((real)1.25)
 /* A group: the candidate and the three same-size candidates nearest to the group's
  * running centroid, all within 2 dx_i of it; kept when none lies farther than dx_i
@@ -80,6 +81,8 @@ static int ensure(rhod_apr *a, size_t n) {
 }
 
 static void group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c);
+static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
+                        const rhod_cells *c);
 
 int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const rhod_cells *c,
                   const rhod_boundary *b, double t, int coalesce) {
@@ -98,7 +101,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real *V = s->V, *P = s->P, *gP = s->gP;
   const uint8_t *reg = s->reg, *near = a->near, *near2 = a->near2, *cmark = c->mark;
   uint8_t *mark = a->mark;
-  real *sd = a->sd;
+  real *sd = a->sd, *sp = a->sp;
   const int kern = s->kernel;
   const real ratio = s->ratio, dmin = a->dx_min * (1 - SIZE_TOL);
   const int c3 = a->free_surface && s->fsdetect, c4 = a->walls;
@@ -151,10 +154,10 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
       /* Coalescing candidate: the criteria for the particle of size D = 2 dx_i at x_i
        * (HYST above). Criterion 3 first from the per-cell free-surface flags of the
        * region pass (conservative: whole cells), then one pass over the support 2 R_i:
-       * no particle of size dx_i/2 or less (criterion 1: it would be D/4), the sum of
-       * Gamma over sizes >= D at least (2 HYST - 1) Gamma_DD with the merged volume
-       * 4 V_i (criterion 2 with margin), and the Shepard field inside the thresholds
-       * with margin (criterion 5). */
+       * no particle of size dx_i/2 or less (criterion 1: it would be D/4) and the
+       * Shepard field inside the thresholds with margin (criterion 5). Criterion 2
+       * needs the other candidates too (coalesce_c2): the sum of Gamma over sizes >= D
+       * is kept in sp. */
       const real RD = 2 * Ri, RD2 = RD * RD, iRD = 1 / RD, iRD2 = iRD * iRD;
       int ok = !(c3 && rhod_cells_near_mark(G, cmark, xi, yi, HYST * RD));
       if (ok) {
@@ -178,7 +181,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
         }
         RHOD_END_NEIGHBOURS
         const real phi2 = num2 / den2;
-        ok = !fine && same2 >= (2 * HYST - 1) * self2 && !(c5 && (phi2 > above2 || phi2 < below2));
+        ok = !fine && !(c5 && (phi2 > above2 || phi2 < below2));
+        sp[i] = same2;
       }
       mark[i] = ok ? 2 : 0;
       ncand += ok;
@@ -237,9 +241,57 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     sd[4 * i + 2] = bx, sd[4 * i + 3] = by; /* e scaled by the aspect a */
   }
-  if (ncand >= 4)
-    group(a, p, c);
+  if (ncand >= 4 && coalesce_c2(a, s, p, c) >= 4) {
+    group(a, p, c); /* the candidates left over go back to 0 */
+  } else if (ncand > 0) {
+    RHOD_KERNEL_LOOP
+    for (long i = 0; i < n; i++)
+      mark[i] = mark[i] == 2 ? 0 : mark[i];
+  }
   return RHOD_OK;
+}
+
+/* Criterion 2 for the particle a candidate's group would make (size D, support RD =
+ * 2 R_i, volume 4 V_i): sum of Gamma over the neighbours of size >= D (sp, from the
+ * marking pass) plus over the candidates of i's size, i included, which will mostly
+ * be merged too (their volume is what the merged particles will have), at least
+ * 2 HYST Gamma_DD. Counting the candidates lets a fine region with no coarser
+ * particle left merge as a whole instead of only from a coarse edge inward. Returns
+ * the candidates kept. */
+static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
+                        const rhod_cells *c) {
+  const long n = (long)p->n;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *V = s->V, *sp = a->sp;
+  uint8_t *mark = a->mark, *acc = a->acc;
+  const int kern = s->kernel;
+  const real ratio = s->ratio;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    acc[i] = 0;
+    if (mark[i] != 2)
+      continue;
+    const real xi = x[i], yi = y[i], dxi = dx[i], RD = 2 * ratio * dxi, RD2 = RD * RD;
+    const real iRD = 1 / RD, iRD2 = iRD * iRD, self2 = rhod_Wq(kern, 0) * iRD2 * 4 * V[i];
+    const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
+    real sum = sp[i];
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RD, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+      if (j < n && r2 < RD2 && mark[j] == 2 && dx[j] > lo && dx[j] < hi)
+        sum += rhod_Wq(kern, sqrt(r2) * iRD) * iRD2 * V[j];
+    }
+    RHOD_END_NEIGHBOURS
+    acc[i] = sum >= 2 * HYST * self2;
+  }
+  long kept = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, kept)
+  for (long i = 0; i < n; i++)
+    if (mark[i] == 2) {
+      mark[i] = acc[i] ? 2 : 0;
+      kept += acc[i];
+    }
+  return kept;
 }
 
 /* Groups of four candidates (mark 2), formed at the marking positions in rounds: each

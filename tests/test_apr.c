@@ -739,11 +739,12 @@ static void test_criteria_1_2(void) {
 /* ------------------------------------------------------------------------------------ */
 /* 7. coalescing: groups on a hand-made store, then whole runs                           */
 
-/* A fine lattice (dx/2, 24 x 24) beside a coarse one (dx, 8 x 12), a linear velocity
- * field and a pressure gradient. Coalescing with criteria 1 and 2 only: candidates
- * are the fine particles near the coarse block (criterion 2 for the merged particle
- * needs coarse neighbours), groups are the lattice's 2 x 2 blocks, and the merge
- * keeps mass, momentum, centre of mass and volume. */
+/* A fine lattice (dx/2, 24 x 24) beside a coarse one (dx, 8 x 12) and one particle of
+ * dx/4 inside the fine block, a linear velocity field and a pressure gradient.
+ * Coalescing with criteria 1 and 2 only: the fine particles group into the lattice's
+ * 2 x 2 blocks, except within 2 R (the merged particle's support) of the dx/4 one,
+ * which would be the merged particle's grandchild (criterion 1); the merge keeps
+ * mass, momentum, centre of mass and volume. */
 static void test_coalesce_groups(void) {
   const double dx = 0.01, h = dx / 2, c0 = 20, rho0 = 1000;
   rhod_scene *sc = unit_scene(dx);
@@ -753,6 +754,8 @@ static void test_coalesce_groups(void) {
   unsigned long seed = 5;
   add_block(&p, 0, 0, 24, 24, h, 0, &seed);       /* x in [0, 12 dx) */
   add_block(&p, 12 * dx, 0, 8, 12, dx, 0, &seed); /* x in [12, 20) dx */
+  const long tiny = (long)p.n;
+  add_block(&p, 3 * dx - h / 4, 6 * dx - h / 4, 1, 1, h / 2, 0, &seed); /* at (3, 6) dx */
   const long n0 = (long)p.n;
   for (long i = 0; i < n0; i++) {
     p.ux[i] = (real)(0.3 + 5 * p.y[i]), p.uy[i] = (real)(-0.1 + 7 * p.x[i]);
@@ -776,13 +779,13 @@ static void test_coalesce_groups(void) {
   CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&a, &s, &p, &c, &nowalls, 0, 1), RHOD_OK);
   rhod_to_host(a.mark, (size_t)n0);
   rhod_to_host(a.grp, 4 * (size_t)n0 * sizeof(int32_t));
-  long leaders = 0, members = 0, coarse_marked = 0, bad_group = 0, far = 0, split = 0;
+  long leaders = 0, members = 0, coarse_marked = 0, bad_group = 0, near = 0, split = 0;
   int *owner = calloc((size_t)n0, sizeof *owner);
   for (long i = 0; i < n0; i++) {
     coarse_marked += p.dx[i] == (real)dx && a.mark[i] > 1;
     split += a.mark[i] == 1;
     members += a.mark[i] == 4;
-    far += a.mark[i] >= 2 && p.x[i] < 12 * dx - 8 * h; /* 2 R of a fine one from the coarse */
+    near += a.mark[i] >= 2 && hypot(p.x[i] - p.x[tiny], p.y[i] - p.y[tiny]) < 8 * h;
     if (a.mark[i] != 3)
       continue;
     leaders++;
@@ -799,11 +802,11 @@ static void test_coalesce_groups(void) {
     }
   }
   printf("\ncoalescing: %ld groups of the %d fine particles\n", leaders, 24 * 24);
-  CU_ASSERT(leaders >= 6); /* 8: the two fine columns next to the coarse block, 44 candidates */
+  CU_ASSERT(leaders >= 60); /* of the 144 blocks, about 50 lie within 2 R of the dx/4 one */
   CU_ASSERT_EQUAL(members, 3 * leaders);
   CU_ASSERT_EQUAL(bad_group, 0);
   CU_ASSERT_EQUAL(coarse_marked, 0); /* dx is the coarsest size */
-  CU_ASSERT_EQUAL(far, 0);
+  CU_ASSERT_EQUAL(near, 0);
   CU_ASSERT_EQUAL(split, 0);
   CU_ASSERT_EQUAL(rhod_apr_split(&a, &s, &p, &nowalls), 0);
   CU_ASSERT_EQUAL(rhod_apr_coalesce(&a, &p), leaders);
