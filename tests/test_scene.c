@@ -315,6 +315,7 @@ static const struct {
     {"refine_field_quantity.yaml", 12, "refinement.field.quantity", "invalid value"},
     {"refine_free_surface_no_detection.yaml", 14, "refinement.free_surface",
      "needs the free-surface detection"},
+    {"refine_coalesce_static.yaml", 13, "refinement.coalesce", "needs dynamic refinement"},
     {"refine_levels_fraction.yaml", 11, "refinement.levels", "whole number"},
     {"refine_levels_zero.yaml", 11, "refinement.levels", "whole number"},
     {"refine_region_level.yaml", 14, "refinement.regions.0.level", "whole number"},
