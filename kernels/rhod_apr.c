@@ -80,7 +80,50 @@ static int ensure(rhod_apr *a, size_t n) {
              : RHOD_ERR_MEMORY;
 }
 
-static void group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c);
+/* The field of criterion 5 at particle j: P, or the dynamic pressure rho |u|^2 / 2. */
+static inline real field_at(int dyn, const real *rho, const real *ux, const real *uy, const real *P,
+                            long j) {
+  return dyn ? (real)0.5 * rho[j] * (ux[j] * ux[j] + uy[j] * uy[j]) : P[j];
+}
+
+/* Sums of the criteria over the neighbours j != i within R of particle i, added to
+ * the variables named (which hold the self terms): Gamma_ij = W(r_ij; R) V_j over
+ * sizes >= big into same (criterion 2), any size <= small into anysmall (criterion 1),
+ * the Shepard sums of the criterion-5 field into num, den (with c5), and the nearest
+ * neighbour into best (r^2, start it at R^2), ex, ey (x_j - x_i). One text for a
+ * particle's own support and for the support 2 R_i of the particle its coalescing
+ * group would make. A macro over the marking loop's locals (G, CS, CI, x, y, dx, V,
+ * rho, ux, uy, P, kern, c5, dyn), not a function: GCC 12 nvptx puts a returned
+ * struct, like pointer outputs, in the warp-shared frame (tests/offload_frames.sh). */
+#define CRITERIA_SUMS(i, R, small, big, same, num, den, best, ex, ey, anysmall)                    \
+  {                                                                                                \
+    const real xs_ = x[i], ys_ = y[i], R2_ = (R) * (R), iR_ = 1 / (R), iR2_ = iR_ * iR_;           \
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xs_, ys_, (R), j) {                                             \
+      const real rx_ = x[j] - xs_, ry_ = y[j] - ys_, r2_ = rx_ * rx_ + ry_ * ry_;                  \
+      if (r2_ < R2_ && j != (i)) {                                                                 \
+        if (r2_ < (best))                                                                          \
+          (best) = r2_, (ex) = rx_, (ey) = ry_;                                                    \
+        const real dxj_ = dx[j];                                                                   \
+        (anysmall) |= dxj_ <= (small);                                                             \
+        const real w_ = rhod_Wq(kern, sqrt(r2_) * iR_) * iR2_ * V[j];                              \
+        (same) += dxj_ >= (big) ? w_ : 0;                                                          \
+        if (c5) {                                                                                  \
+          const real phij_ = field_at(dyn, rho, ux, uy, P, j);                                     \
+          (num) += w_ * phij_, (den) += w_;                                                        \
+        }                                                                                          \
+      }                                                                                            \
+    }                                                                                              \
+    RHOD_END_NEIGHBOURS                                                                            \
+  }
+
+/* Candidates not grouped go back to no mark. */
+static void drop_candidates(uint8_t *mark, long n) {
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++)
+    mark[i] = mark[i] == 2 ? 0 : mark[i];
+}
+
+static long group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c);
 static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
                         const rhod_cells *c);
 
@@ -124,28 +167,13 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     const real iR = 1 / Ri, iR2 = iR * iR;
     const real self = rhod_Wq(kern, 0) * iR2 * V[i]; /* Gamma_ii, Eq. 7 */
-    const real phii = dyn ? (real)0.5 * rho[i] * (ux[i] * ux[i] + uy[i] * uy[i]) : P[i];
+    const real phii = field_at(dyn, rho, ux, uy, P, i);
+    const real quarter = (real)0.25 * dxi * (1 + SIZE_TOL), lower = dxi * (1 - SIZE_TOL);
     real best = R2, ex = 1, ey = 0;
     real same = self; /* criterion 2: sum of Gamma_ij over dx_j >= dx_i, i included */
     real num = self * phii, den = self; /* criterion 5: Shepard average, i included */
     int grand = 0;                      /* criterion 1 */
-    const real quarter = (real)0.25 * dxi * (1 + SIZE_TOL), lower = dxi * (1 - SIZE_TOL);
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
-      if (r2 < R2 && j != i) {
-        if (r2 < best)
-          best = r2, ex = rx, ey = ry;
-        const real dxj = dx[j];
-        grand |= dxj <= quarter;
-        const real w = rhod_Wq(kern, sqrt(r2) * iR) * iR2 * V[j];
-        same += dxj >= lower ? w : 0;
-        if (c5) {
-          const real phij = dyn ? (real)0.5 * rho[j] * (ux[j] * ux[j] + uy[j] * uy[j]) : P[j];
-          num += w * phij, den += w;
-        }
-      }
-    }
-    RHOD_END_NEIGHBOURS
+    CRITERIA_SUMS(i, Ri, quarter, lower, same, num, den, best, ex, ey, grand);
     const real phi = num / den;
     const int m = can_split && (grand || same < 2 * self || (c3 && reg[i] != 0) ||
                                 (c4 && near[i]) || (c5 && (phi > above || phi < below)));
@@ -158,28 +186,15 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
        * Shepard field inside the thresholds with margin (criterion 5). Criterion 2
        * needs the other candidates too (coalesce_c2): the sum of Gamma over sizes >= D
        * is kept in sp. */
-      const real RD = 2 * Ri, RD2 = RD * RD, iRD = 1 / RD, iRD2 = iRD * iRD;
+      const real RD = 2 * Ri, iRD = 1 / RD, iRD2 = iRD * iRD;
       int ok = !(c3 && rhod_cells_near_mark(G, cmark, xi, yi, HYST * RD));
       if (ok) {
-        const real self2 = rhod_Wq(kern, 0) * iRD2 * 4 * V[i],
-                   half = (real)0.5 * dxi * (1 + SIZE_TOL);
-        const real big = 2 * dxi * (1 - SIZE_TOL);
-        real same2 = 0, num2 = self2 * phii, den2 = self2;
+        const real self2 = rhod_Wq(kern, 0) * iRD2 * 4 * V[i];
+        const real half = (real)0.5 * dxi * (1 + SIZE_TOL), big = 2 * dxi * (1 - SIZE_TOL);
+        real same2 = 0, num2 = self2 * phii, den2 = self2, best2 = RD * RD, ex2 = 1, ey2 = 0;
         int fine = 0;
-        RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RD, j) {
-          const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
-          if (r2 < RD2 && j != i) {
-            const real dxj = dx[j];
-            fine |= dxj <= half;
-            const real w = rhod_Wq(kern, sqrt(r2) * iRD) * iRD2 * V[j];
-            same2 += dxj >= big ? w : 0;
-            if (c5) {
-              const real phij = dyn ? (real)0.5 * rho[j] * (ux[j] * ux[j] + uy[j] * uy[j]) : P[j];
-              num2 += w * phij, den2 += w;
-            }
-          }
-        }
-        RHOD_END_NEIGHBOURS
+        CRITERIA_SUMS(i, RD, half, big, same2, num2, den2, best2, ex2, ey2, fine);
+        (void)ex2, (void)ey2; /* the nearest neighbour is not needed here */
         const real phi2 = num2 / den2;
         ok = !fine && !(c5 && (phi2 > above2 || phi2 < below2));
         sp[i] = same2;
@@ -241,13 +256,9 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     sd[4 * i + 2] = bx, sd[4 * i + 3] = by; /* e scaled by the aspect a */
   }
-  if (ncand >= 4 && coalesce_c2(a, s, p, c) >= 4) {
-    group(a, p, c); /* the candidates left over go back to 0 */
-  } else if (ncand > 0) {
-    RHOD_KERNEL_LOOP
-    for (long i = 0; i < n; i++)
-      mark[i] = mark[i] == 2 ? 0 : mark[i];
-  }
+  a->groups = ncand >= 4 && coalesce_c2(a, s, p, c) >= 4 ? group(a, p, c) : 0;
+  if (ncand > 0)
+    drop_candidates(mark, n); /* the candidates left over */
   return RHOD_OK;
 }
 
@@ -299,20 +310,17 @@ static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
  * containing it with the smallest spread (ties: the lower index), and a proposal whose
  * four members all took it is accepted: leader mark 3, members 4. On a lattice every
  * spread ties and overlapping proposals block each other, so one round accepts few;
- * GROUP_ROUNDS rounds (or until one accepts none), then the candidates left go back
- * to 0 and may group at a later marking. Every pass writes only its own particle's
- * entries. */
+ * GROUP_ROUNDS rounds (or until one accepts none); the candidates left over may
+ * group at a later marking. Returns the groups accepted. Every pass writes only its
+ * own particle's entries. */
 #define GROUP_ROUNDS 6
 static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *c);
 
-static void group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c) {
-  for (int r = 0; r < GROUP_ROUNDS && group_round(a, p, c) > 0; r++)
-    ;
-  const long n = (long)p->n;
-  uint8_t *mark = a->mark;
-  RHOD_KERNEL_LOOP
-  for (long i = 0; i < n; i++)
-    mark[i] = mark[i] == 2 ? 0 : mark[i];
+static long group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c) {
+  long total = 0, got = 1;
+  for (int r = 0; r < GROUP_ROUNDS && got > 0; r++)
+    total += got = group_round(a, p, c);
+  return total;
 }
 
 static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *c) {
@@ -487,20 +495,17 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
 long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   const long n = (long)p->n, nm = a->n_marked;
   a->merged_last = 0;
-  if (!a->coalesce || !a->mark || nm > n)
+  const long groups = a->groups;
+  a->groups = 0;
+  if (groups == 0 || nm > n)
     return 0;
   const uint8_t *mark = a->mark;
   const int32_t *grp = a->grp;
   int32_t *cnt = a->cnt;
   real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *m = p->m, *dx = p->dx;
-  long groups = 0;
-  RHOD_KERNEL_LOOP_REDUCE(+, groups)
-  for (long i = 0; i <= nm; i++) {
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i <= nm; i++)
     cnt[i] = i < nm && mark[i] != 4;
-    groups += i < nm && mark[i] == 3;
-  }
-  if (groups == 0)
-    return 0;
   /* The merged particle, in the leader's slot (our choice, docs/choices.md): mass
    * m = sum m_k; position and velocity the mass-weighted means (centre of mass and
    * momentum conserved, as in paper 004 Sec. 2.3); volume V = sum m_k / rho_k

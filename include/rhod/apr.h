@@ -41,6 +41,7 @@ typedef struct {
   uint8_t *acc;   /* cap: 1 = the candidate's proposed group was accepted */
   real *sp;       /* cap: the proposal's spread (smaller wins), or 1e30 for none */
   long n_marked;  /* fluid particles when marked (coalescing indices are below it) */
+  long groups;    /* groups the last marking accepted, for rhod_apr_coalesce */
   long split_last, split_total;   /* particles split by the last call and by the run */
   long merged_last, merged_total; /* groups coalesced by the last call and by the run */
 } rhod_apr;
