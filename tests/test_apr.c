@@ -401,6 +401,9 @@ static void test_free_surface_flags(void) {
 /* What rhod_sim_step does in its last stage, on a hand-made store with no walls: the
  * scheme's fields of one right-hand side (cells over [lo, hi] made for R = 4 dx), then
  * the refinement criteria with dx_min. */
+/* No walls (a zeroed boundary) for the hand-made stores. */
+static const rhod_boundary nowalls;
+
 static void mark_store(rhod_scene *sc, rhod_particles *p, rhod_sph *s, rhod_cells *c, rhod_apr *a,
                        const double lo[2], const double hi[2], double dx, double dx_min) {
   CU_ASSERT_EQUAL_FATAL(rhod_sph_init(s, sc, p), RHOD_OK);
@@ -409,10 +412,8 @@ static void mark_store(rhod_scene *sc, rhod_particles *p, rhod_sph *s, rhod_cell
   rhod_sph_fill_state(s, p);
   rhod_cells_build(c, p->x, p->y, p->n);
   rhod_sph_rhs(s, p, c, (real)1e-4);
-  rhod_boundary bnd;
-  memset(&bnd, 0, sizeof bnd);
   CU_ASSERT_EQUAL_FATAL(rhod_apr_init(a, sc, dx_min), RHOD_OK);
-  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(a, s, p, c, &bnd, 0, 0), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(a, s, p, c, &nowalls, 0, 0), RHOD_OK);
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -466,8 +467,6 @@ static void test_split_geometry(void) {
     }
   }
   const uint64_t id0 = p.next_id;
-  rhod_boundary nowalls;
-  memset(&nowalls, 0, sizeof nowalls);
   const long split = rhod_apr_split(&a, &s, &p, &nowalls);
   rhod_particles_to_host(&p);
   CU_ASSERT_EQUAL(split, k);
@@ -615,8 +614,6 @@ static void test_split_strained_lattice(void) {
   rhod_cells c;
   rhod_apr a;
   mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
-  rhod_boundary nowalls;
-  memset(&nowalls, 0, sizeof nowalls);
   CU_ASSERT_EQUAL(rhod_apr_split(&a, &s, &p, &nowalls), n0);
   rhod_particles_to_host(&p);
   CU_ASSERT_EQUAL_FATAL((long)p.n, 4 * n0);
@@ -773,8 +770,6 @@ static void test_coalesce_groups(void) {
   rhod_cells c;
   rhod_apr a;
   mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
-  rhod_boundary nowalls;
-  memset(&nowalls, 0, sizeof nowalls);
   /* again with coalescing (mark_store marked without) */
   CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&a, &s, &p, &c, &nowalls, 0, 1), RHOD_OK);
   rhod_to_host(a.mark, (size_t)n0);
