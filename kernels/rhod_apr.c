@@ -173,7 +173,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     real same = self; /* criterion 2: sum of Gamma_ij over dx_j >= dx_i, i included */
     real num = self * phii, den = self; /* criterion 5: Shepard average, i included */
     int grand = 0;                      /* criterion 1 */
-    CRITERIA_SUMS(i, Ri, quarter, lower, same, num, den, best, ex, ey, grand);
+    if (can_split) /* a particle at dx_min is here only as a coalescing candidate */
+      CRITERIA_SUMS(i, Ri, quarter, lower, same, num, den, best, ex, ey, grand);
     const real phi = num / den;
     const int m = can_split && (grand || same < 2 * self || (c3 && reg[i] != 0) ||
                                 (c4 && near[i]) || (c5 && (phi > above || phi < below)));
