@@ -1,29 +1,29 @@
 /* Adaptive particle refinement, paper 002 Sec. V: criteria (V B), the 1 -> 4 split
- * (V A) and its inverse, coalescing (ours, after paper 004 Sec. 2.3). All are
- * per-particle loops that write only particle i's own entries (the children of i go
- * to slots reserved for i by a scan; a merged group is written by its leader), so
- * they run on the device like every other kernel. */
+ * (V A) or the 1 -> 3 of the Appendix, and its inverse, coalescing (ours, after paper 004
+ * Sec. 2.3). All are per-particle loops that write only particle i's own entries (the children of i
+ * go to slots reserved for i by a scan; a merged group is written by its leader), so they run on
+ * the device like every other kernel. */
 #include "kernel.h"
 #include "rhod/apr.h"
 #include "rhod/device.h"
 #include <math.h>
 #include <string.h>
 
-/* Relative tolerance when comparing sizes: sizes are dx / 2^l, equal up to rounding. */
+/* Relative tolerance when comparing sizes: sizes are dx / e^l, equal up to rounding. */
 #define SIZE_TOL ((real)1e-3)
 
 /* Coalescing (our choices, docs/choices.md "APR coalescing"). A particle of size dx_i
- * is a candidate when the particle of size 2 dx_i that its group would become would
+ * is a candidate when the particle of size e dx_i that its group would become would
  * not be refined again: criteria 1, 2 and 5 evaluated for the support of radius
- * 2 R_i, criteria 3 and 4 for a support HYST times wider, criterion 2 and the
+ * e R_i, criteria 3 and 4 for a support HYST times wider, criterion 2 and the
  * thresholds of 5 with the same margin (the hysteresis that keeps a particle from
  * splitting and merging in turn). Criterion 2 counts the other candidates as the
  * merged particles they will mostly become (coalesce_c2). */
 #define HYST ((real)1.25)
-/* A group: the candidate and the three same-size candidates nearest to the group's
- * running centroid, all within 2 dx_i of it; kept when none lies farther than dx_i
- * from the centre of mass (a 2 x 2 block of a lattice: 0.71 dx_i) and no other
- * particle j comes nearer to that centre than Q_MIN (2 dx_i + dx_j)/2, the spacing
+/* A group: the candidate and the three (triangle: two) same-size candidates nearest to
+ * the group's running centroid, all within 2 dx_i of it; kept when none lies farther
+ * than dx_i from the centre of mass (a 2 x 2 block of a lattice: 0.71 dx_i) and no
+ * other particle j comes nearer to that centre than Q_MIN (e dx_i + dx_j)/2, the spacing
  * of the merged particle and j on a regular layout (0.5 of it, which is where the
  * children of a split stand on a regular lattice too). */
 #define Q_MIN ((real)0.5)
@@ -40,6 +40,9 @@ int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   a->above = (real)fmin(sc->field_above, 1e30);
   a->below = (real)fmax(sc->field_below, -1e30);
   a->from = (real)sc->field_from;
+  a->nsplit = rhod_pattern_children(sc->pattern);
+  a->eps = (real)rhod_pattern_ratio(sc->pattern);
+  a->ieps = (real)(1 / rhod_pattern_ratio(sc->pattern));
   a->coalesce = sc->refine_coalesce;
   a->dx_max = (real)sc->dx;
   return RHOD_OK;
@@ -137,7 +140,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   if (a->walls)
     rhod_walls_near(b, p, s->ratio, a->near);
   if (a->walls && co)
-    rhod_walls_near(b, p, 2 * HYST * s->ratio, a->near2);
+    rhod_walls_near(b, p, a->eps * HYST * s->ratio, a->near2);
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
   const real *x = p->x, *y = p->y, *dx = p->dx, *ux = p->ux, *uy = p->uy, *rho = p->rho;
@@ -147,12 +150,14 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   real *sd = a->sd, *sp = a->sp;
   const int kern = s->kernel;
   const real ratio = s->ratio, dmin = a->dx_min * (1 - SIZE_TOL);
+  const real eps = a->eps, ieps = a->ieps, nsplit = (real)a->nsplit;
+  const int tri = a->nsplit == 3;
   const int c3 = a->free_surface && s->fsdetect, c4 = a->walls;
   const int c5 = a->field && (real)t >= a->from, dyn = a->qty == RHOD_QTY_DYNAMIC_PRESSURE;
   const real above = a->above, below = a->below;
   /* coalescing: the largest size that may merge, the thresholds of criterion 5 with
    * the margin (HYST - 1) |threshold| (1e30 stands for none and stays far away) */
-  const real dgrow = (real)0.5 * a->dx_max * (1 + SIZE_TOL);
+  const real dgrow = ieps * a->dx_max * (1 + SIZE_TOL);
   const real above2 = above - (HYST - 1) * fabs(above), below2 = below + (HYST - 1) * fabs(below);
   long ncand = 0;
   RHOD_KERNEL_LOOP_REDUCE(+, ncand)
@@ -160,7 +165,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     const real xi = x[i], yi = y[i], dxi = dx[i], Ri = ratio * dxi, R2 = Ri * Ri;
     sd[4 * i] = gP[2 * i], sd[4 * i + 1] = gP[2 * i + 1];
     sd[4 * i + 2] = 1, sd[4 * i + 3] = 0;
-    const int can_split = (real)0.5 * dxi >= dmin; /* dx_min is never crossed (Sec. V B) */
+    const int can_split = dxi * ieps >= dmin; /* dx_min is never crossed (Sec. V B) */
     if (!can_split && !(co && dxi <= dgrow)) {
       mark[i] = 0;
       continue;
@@ -168,7 +173,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     const real iR = 1 / Ri, iR2 = iR * iR;
     const real self = rhod_Wq(kern, 0) * iR2 * V[i]; /* Gamma_ii, Eq. 7 */
     const real phii = field_at(dyn, rho, ux, uy, P, i);
-    const real quarter = (real)0.25 * dxi * (1 + SIZE_TOL), lower = dxi * (1 - SIZE_TOL);
+    /* criterion 1: a neighbour two levels finer, dx_i / e^2 (dx_i / 4 at e = 2) */
+    const real quarter = dxi * ieps * ieps * (1 + SIZE_TOL), lower = dxi * (1 - SIZE_TOL);
     real best = R2, ex = 1, ey = 0;
     real same = self; /* criterion 2: sum of Gamma_ij over dx_j >= dx_i, i included */
     real num = self * phii, den = self; /* criterion 5: Shepard average, i included */
@@ -180,18 +186,18 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
                                 (c4 && near[i]) || (c5 && (phi > above || phi < below)));
     mark[i] = (uint8_t)m;
     if (!m && co && dxi <= dgrow && !(c3 && reg[i] != 0) && !(c4 && near2[i])) {
-      /* Coalescing candidate: the criteria for the particle of size D = 2 dx_i at x_i
+      /* Coalescing candidate: the criteria for the particle of size D = e dx_i at x_i
        * (HYST above). Criterion 3 first from the per-cell free-surface flags of the
-       * region pass (conservative: whole cells), then one pass over the support 2 R_i:
-       * no particle of size dx_i/2 or less (criterion 1: it would be D/4) and the
+       * region pass (conservative: whole cells), then one pass over the support e R_i:
+       * no particle of size dx_i/e or less (criterion 1: it would be D/e^2) and the
        * Shepard field inside the thresholds with margin (criterion 5). Criterion 2
        * needs the other candidates too (coalesce_c2): the sum of Gamma over sizes >= D
        * is kept in sp. */
-      const real RD = 2 * Ri, iRD = 1 / RD, iRD2 = iRD * iRD;
+      const real RD = eps * Ri, iRD = 1 / RD, iRD2 = iRD * iRD;
       int ok = !(c3 && rhod_cells_near_mark(G, cmark, xi, yi, HYST * RD));
       if (ok) {
-        const real self2 = rhod_Wq(kern, 0) * iRD2 * 4 * V[i];
-        const real half = (real)0.5 * dxi * (1 + SIZE_TOL), big = 2 * dxi * (1 - SIZE_TOL);
+        const real self2 = rhod_Wq(kern, 0) * iRD2 * nsplit * V[i];
+        const real half = ieps * dxi * (1 + SIZE_TOL), big = eps * dxi * (1 - SIZE_TOL);
         real same2 = 0, num2 = self2 * phii, den2 = self2, best2 = RD * RD, ex2 = 1, ey2 = 0;
         int fine = 0;
         CRITERIA_SUMS(i, RD, half, big, same2, num2, den2, best2, ex2, ey2, fine);
@@ -220,6 +226,10 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
      * a dam break's stretching) the square would put a child nearly on top of a
      * neighbour's child; the rectangle follows the strain and the children form the
      * same strained lattice at half the spacing.
+     * Triangle (1 -> 3, Appendix, Fig. 32; the paper gives no placement): the children
+     * at the corners of the equilateral triangle of side dx_i/sqrt 3 (their own size)
+     * centred on x_i, circumradius dx_i/3, one corner along e; the same score over
+     * the turns 0, 15, ... 105 degrees (the triangle repeats every 120), no aspect.
      * One neighbour pass per pattern, each with a scalar minimum, the turns made by a
      * constant 15-degree rotation: an array of minima, or cos/sin of a variable angle
      * (fused into sincos() with pointer outputs), would be an addressable local, which
@@ -227,23 +237,28 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
      * Only marked particles pay for the passes. */
     const real e0 = sqrt(best), h = (real)0.25 * dxi, reach = 2 * dxi, reach2 = reach * reach;
     const real c15 = (real)0.96592582628906829, s15 = (real)0.25881904510252076;
+    const real s32 = (real)0.86602540378443865, rt = dxi / 3;
+    const int turns = tri ? 8 : 6, aspects = tri ? 1 : 9;
     real sbest = (real)-1e30, fx = ex / e0, fy = ey / e0, bx = fx, by = fy;
-    for (int k = 0; k < 6; k++) {
+    for (int k = 0; k < turns; k++) {
       real up = 1;
-      for (int q = 0; q < 9; q++) {
+      for (int q = 0; q < aspects; q++) {
         /* q = 0: a = 1; then 1.25, 0.8, 1.25^2, 1.25^-2, ... */
         up = (q & 1) ? up * (real)1.25 : up;
         const real a = (q & 1) || q == 0 ? up : 1 / up, ha = h * a, hb = h / a;
-        real score = 2 * (a < 1 ? ha : hb);
+        real score = tri ? s32 * 2 * rt : 2 * (a < 1 ? ha : hb);
         RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
           const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
           if (j != i && r2 < reach2) {
             /* w_i r of Eq. 12 (exactly r/2 at equal sizes: x / (x + x) = 0.5) */
             const real r = sqrt(r2), wr = dxi / (dxi + dx[j]) * r;
-            /* the child farthest along n_ij: |o.n| is largest at the corner whose
-             * signs match those of (e.n, e_perp.n) */
+            /* the child farthest along n_ij. Rectangle: |o.n| is largest at the
+             * corner whose signs match those of (e.n, e_perp.n). Triangle: the
+             * largest of rt (c_k e.n + s_k e_perp.n) over the corners (c, s) = (1, 0),
+             * (-1/2, +-sqrt(3)/2) */
             const real en = (fx * rx + fy * ry) / r, pn = (fx * ry - fy * rx) / r;
-            const real on = ha * fabs(en) + hb * fabs(pn);
+            const real tn = -(real)0.5 * en + s32 * fabs(pn);
+            const real on = tri ? rt * (en > tn ? en : tn) : ha * fabs(en) + hb * fabs(pn);
             const real sj = 2 * (wr - on);
             score = sj < score ? sj : score;
           }
@@ -264,8 +279,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
 }
 
 /* Criterion 2 for the particle a candidate's group would make (size D, support RD =
- * 2 R_i, volume 4 V_i): sum of Gamma over the neighbours of size >= D (sp, from the
- * marking pass) plus over the candidates of i's size, i included, which will mostly
+ * e R_i, volume N V_i, N the children of a split): sum of Gamma over the neighbours of size >= D
+ * (sp, from the marking pass) plus over the candidates of i's size, i included, which will mostly
  * be merged too (their volume is what the merged particles will have), at least
  * 2 HYST Gamma_DD. Counting the candidates lets a fine region with no coarser
  * particle left merge as a whole instead of only from a coarse edge inward. Returns
@@ -278,14 +293,14 @@ static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
   const real *x = p->x, *y = p->y, *dx = p->dx, *V = s->V, *sp = a->sp;
   uint8_t *mark = a->mark, *acc = a->acc;
   const int kern = s->kernel;
-  const real ratio = s->ratio;
+  const real ratio = s->ratio, eps = a->eps, nsplit = (real)a->nsplit;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     acc[i] = 0;
     if (mark[i] != 2)
       continue;
-    const real xi = x[i], yi = y[i], dxi = dx[i], RD = 2 * ratio * dxi, RD2 = RD * RD;
-    const real iRD = 1 / RD, iRD2 = iRD * iRD, self2 = rhod_Wq(kern, 0) * iRD2 * 4 * V[i];
+    const real xi = x[i], yi = y[i], dxi = dx[i], RD = eps * ratio * dxi, RD2 = RD * RD;
+    const real iRD = 1 / RD, iRD2 = iRD * iRD, self2 = rhod_Wq(kern, 0) * iRD2 * nsplit * V[i];
     const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
     real sum = sp[i];
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RD, j) {
@@ -306,11 +321,11 @@ static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
   return kept;
 }
 
-/* Groups of four candidates (mark 2), formed at the marking positions in rounds: each
- * candidate left proposes one (Q_MIN above), each candidate takes the proposal
- * containing it with the smallest spread (ties: the lower index), and a proposal whose
- * four members all took it is accepted: leader mark 3, members 4. On a lattice every
- * spread ties and overlapping proposals block each other, so one round accepts few;
+/* Groups of four (triangle: three) candidates (mark 2), formed at the marking
+ * positions in rounds: each candidate left proposes one (Q_MIN above), each candidate
+ * takes the proposal containing it with the smallest spread (ties: the lower index),
+ * and a proposal whose members all took it is accepted: leader mark 3, members 4. On a lattice
+ * every spread ties and overlapping proposals block each other, so one round accepts few;
  * GROUP_ROUNDS rounds (or until one accepts none); the candidates left over may
  * group at a later marking. Returns the groups accepted. Every pass writes only its
  * own particle's entries. */
@@ -332,6 +347,8 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
   uint8_t *mark = a->mark, *acc = a->acc;
   int32_t *grp = a->grp, *claim = a->claim;
   real *sp = a->sp;
+  const real eps = a->eps;
+  const int others = a->nsplit - 1; /* members besides the candidate: 3 or 2 */
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     sp[i] = NONE;
@@ -341,7 +358,7 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
     const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
     int32_t g1 = -1, g2 = -1, g3 = -1;
     real cx = xi, cy = yi;
-    for (int r = 0; r < 3; r++) {
+    for (int r = 0; r < others; r++) {
       real bd = reach2;
       int32_t bj = -1;
       RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
@@ -357,18 +374,20 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
       g1 = r == 0 ? bj : g1, g2 = r == 1 ? bj : g2, g3 = r == 2 ? bj : g3;
       cx += (x[bj] - cx) / (r + 2), cy += (y[bj] - cy) / (r + 2);
     }
-    if (g3 < 0)
+    if (others == 3 ? g3 < 0 : g2 < 0)
       continue;
-    /* centre of mass and spread */
-    const real M = m[i] + m[g1] + m[g2] + m[g3];
-    const real X = (m[i] * xi + m[g1] * x[g1] + m[g2] * x[g2] + m[g3] * x[g3]) / M;
-    const real Y = (m[i] * yi + m[g1] * y[g1] + m[g2] * y[g2] + m[g3] * y[g3]) / M;
+    /* centre of mass and spread (a group of three has no g3: its terms are zero) */
+    const real m3 = others == 3 ? m[g3] : 0, x3 = others == 3 ? x[g3] : 0;
+    const real y3 = others == 3 ? y[g3] : 0;
+    const real M = m[i] + m[g1] + m[g2] + m3;
+    const real X = (m[i] * xi + m[g1] * x[g1] + m[g2] * x[g2] + m3 * x3) / M;
+    const real Y = (m[i] * yi + m[g1] * y[g1] + m[g2] * y[g2] + m3 * y3) / M;
     real s2 = (xi - X) * (xi - X) + (yi - Y) * (yi - Y);
     real d = (x[g1] - X) * (x[g1] - X) + (y[g1] - Y) * (y[g1] - Y);
     s2 = d > s2 ? d : s2;
     d = (x[g2] - X) * (x[g2] - X) + (y[g2] - Y) * (y[g2] - Y);
     s2 = d > s2 ? d : s2;
-    d = (x[g3] - X) * (x[g3] - X) + (y[g3] - Y) * (y[g3] - Y);
+    d = others == 3 ? (x3 - X) * (x3 - X) + (y3 - Y) * (y3 - Y) : 0;
     s2 = d > s2 ? d : s2;
     if (s2 > dxi * dxi)
       continue;
@@ -377,14 +396,15 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
     const real look = 3 * dxi;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, X, Y, look, j) {
       if (j != i && j != g1 && j != g2 && j != g3) {
-        const real rx = x[j] - X, ry = y[j] - Y, q = Q_MIN * (dxi + (real)0.5 * dx[j]);
+        const real rx = x[j] - X, ry = y[j] - Y, q = Q_MIN * ((real)0.5 * (eps * dxi + dx[j]));
         room &= rx * rx + ry * ry >= q * q;
       }
     }
     RHOD_END_NEIGHBOURS
     if (!room)
       continue;
-    grp[4 * i] = (int32_t)i, grp[4 * i + 1] = g1, grp[4 * i + 2] = g2, grp[4 * i + 3] = g3;
+    grp[4 * i] = (int32_t)i, grp[4 * i + 1] = g1, grp[4 * i + 2] = g2;
+    grp[4 * i + 3] = others == 3 ? g3 : -1;
     sp[i] = s2;
   }
   RHOD_KERNEL_LOOP
@@ -407,7 +427,7 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++)
     acc[i] = sp[i] < NONE && claim[grp[4 * i]] == i && claim[grp[4 * i + 1]] == i &&
-             claim[grp[4 * i + 2]] == i && claim[grp[4 * i + 3]] == i;
+             claim[grp[4 * i + 2]] == i && (grp[4 * i + 3] < 0 || claim[grp[4 * i + 3]] == i);
   long accepted = 0;
   RHOD_KERNEL_LOOP_REDUCE(+, accepted)
   for (long j = 0; j < n; j++)
@@ -426,9 +446,10 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
     return 0;
   uint8_t *mark = a->mark;
   int32_t *cnt = a->cnt;
+  const int nsplit = a->nsplit, extra = nsplit - 1; /* the parent's slot keeps a child */
   RHOD_KERNEL_LOOP
   for (long i = 0; i <= n; i++)
-    cnt[i] = i < n && mark[i] == 1 ? 3 : 0;
+    cnt[i] = i < n && mark[i] == 1 ? extra : 0;
   const long added = rhod_scan_exclusive(cnt, (size_t)n + 1);
   if (added <= 0)
     return added;
@@ -438,7 +459,7 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++)
     if (mark[i] == 1)
-      for (int k = 0; k < 3; k++)
+      for (int k = 0; k < extra; k++)
         src[cnt[i] + k] = (int32_t)i;
   /* velocity (u_child = u_i, Sec. V A) and every other persistent array come along */
   rhod_particles_append(p, src, (size_t)added);
@@ -447,6 +468,7 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   const real *sd = a->sd;
   const uint64_t id0 = p->next_id;
   const real c2 = s->c0 * s->c0, ic2 = 1 / c2, rho0 = s->rho0;
+  const real ieps = a->ieps, inn = 1 / (real)nsplit, s32 = (real)0.86602540378443865;
   const real *seg = b->seg, *circ = b->circ;
   const int nseg = b->nseg, ncirc = b->ncirc;
   RHOD_KERNEL_LOOP
@@ -459,12 +481,17 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
     /* Fig. 5: children at the corners of a square of side dx_i/2 centred on x_i (on
      * the circle of radius dx_i/(2 sqrt 2)), sides along and across the direction e
      * to the nearest neighbour; in general the rectangle of the same area and aspect
-     * a chosen by rhod_apr_mark, which stores a e */
+     * a chosen by rhod_apr_mark, which stores a e. Triangle (Appendix): the corners
+     * of the equilateral triangle of circumradius dx_i/3 with one corner along e. */
     const real a = sqrt(sd[4 * i + 2] * sd[4 * i + 2] + sd[4 * i + 3] * sd[4 * i + 3]);
     const real ex = sd[4 * i + 2] / a, ey = sd[4 * i + 3] / a;
-    const real ha = (real)0.25 * dxi * a, hb = (real)0.25 * dxi / a;
-    for (int k = 0; k < 4; k++) {
-      const real sa = (k & 1) ? ha : -ha, sb = (k & 2) ? hb : -hb;
+    const real ha = (real)0.25 * dxi * a, hb = (real)0.25 * dxi / a, rt = dxi / 3;
+    const real dc = dxi * ieps; /* the children's size */
+    for (int k = 0; k < nsplit; k++) {
+      /* (sa, sb): the child's offset along e and across it */
+      const real sa = nsplit == 3 ? (k == 0 ? rt : -(real)0.5 * rt) : ((k & 1) ? ha : -ha);
+      const real sb =
+          nsplit == 3 ? (k == 0 ? 0 : (k == 1 ? s32 : -s32) * rt) : ((k & 2) ? hb : -hb);
       /* Our choice (the paper is silent): a child that would land behind a wall, or
        * nearer to it than a quarter of its size, is moved along the wall normal to a
        * quarter of its size in front (half would push both children of a parent
@@ -473,24 +500,25 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
        * projected at the moved place. */
       const rhod_point q =
           rhod_walls_keep_off(seg, nseg, circ, ncirc, xi + sa * ex - sb * ey,
-                              yi + sa * ey + sb * ex, (real)0.125 * dxi, (real)0.5 * dxi);
+                              yi + sa * ey + sb * ex, (real)0.25 * dc, (real)0.5 * dxi);
       const real ox = q.x - xi, oy = q.y - yi;
       const long c = k == 0 ? i : n + cnt[i] + k - 1;
       /* Sec. V A: P_c = P_i + <grad P>^L_i . (x_c - x_i), rho_c from Eq. 2,
-       * m_c = m_i/4 so that V_c = (V_i rho_i / 4) / rho_c */
+       * m_c = m_i/N so that V_c = (V_i rho_i / N) / rho_c (N = 4; 3 for the triangle,
+       * the Appendix's "modified consistently") */
       const real Pc = Pi + gx * ox + gy * oy;
       x[c] = q.x, y[c] = q.y;
       rho[c] = rho0 + Pc * ic2;
-      m[c] = (real)0.25 * mi;
-      dx[c] = (real)0.5 * dxi;
+      m[c] = inn * mi;
+      dx[c] = dc;
       if (k > 0)
         id[c] = id0 + (uint64_t)(cnt[i] + k - 1);
     }
   }
   p->next_id += (uint64_t)added;
-  a->split_last = added / 3;
-  a->split_total += added / 3;
-  return added / 3;
+  a->split_last = added / extra;
+  a->split_total += added / extra;
+  return added / extra;
 }
 
 long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
@@ -504,6 +532,8 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   const int32_t *grp = a->grp;
   int32_t *cnt = a->cnt;
   real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *m = p->m, *dx = p->dx;
+  const int nsplit = a->nsplit;
+  const real dx_max = a->dx_max, ieps = a->ieps;
   RHOD_KERNEL_LOOP
   for (long i = 0; i <= nm; i++)
     cnt[i] = i < nm && mark[i] != 4;
@@ -511,21 +541,26 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
    * m = sum m_k; position and velocity the mass-weighted means (centre of mass and
    * momentum conserved, as in paper 004 Sec. 2.3); volume V = sum m_k / rho_k
    * conserved, so rho = m / V (the inverse of the split's V_c = (V_i rho_i / 4) /
-   * rho_c); size 2 dx_k; the leader's id. The kinetic energy of the members' motion
+   * rho_c); the next coarser size; the leader's id. The kinetic energy of the members' motion
    * about their mean is lost (a dissipation the energy probes see). */
   RHOD_KERNEL_LOOP
   for (long i = 0; i < nm; i++) {
     if (mark[i] != 3)
       continue;
     real M = 0, X = 0, Y = 0, U = 0, W = 0, V = 0;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < nsplit; k++) {
       const int32_t j = grp[4 * i + k];
       const real mj = m[j];
       M += mj, X += mj * x[j], Y += mj * y[j], U += mj * ux[j], W += mj * uy[j];
       V += mj / rho[j];
     }
     x[i] = X / M, y[i] = Y / M, ux[i] = U / M, uy[i] = W / M;
-    m[i] = M, rho[i] = M / V, dx[i] = 2 * dx[i];
+    /* the size one level up, made by the multiplications the splits make from
+     * particles.dx, so that it equals the sizes of that level exactly (2 dx at e = 2) */
+    real D = dx_max;
+    while (D * ieps > dx[i] * (1 + SIZE_TOL))
+      D *= ieps;
+    m[i] = M, rho[i] = M / V, dx[i] = D;
   }
   const long kept = rhod_scan_exclusive(cnt, (size_t)nm + 1);
   int32_t *perm = p->perm;

@@ -182,8 +182,8 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   const rhod_scene *sc = c->sc;
   const double *lo = sc->picture_box_set ? sc->picture_box_min : s->lo;
   const double *hi = sc->picture_box_set ? sc->picture_box_max : s->hi;
-  st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_width, lo, hi,
-                          sc->picture_range_set ? sc->picture_range : NULL, err, len);
+  st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_size_panel, sc->picture_width, lo,
+                          hi, sc->picture_range_set ? sc->picture_range : NULL, err, len);
   return st;
 }
 

@@ -1,6 +1,7 @@
 /* PNG pictures of one particle field: each particle a filled disc of its own size in the
  * frame [lo, hi] (y up), coloured by viridis; below the frame a strip with the colour bar,
- * its range and the time in a built-in 5x7 bitmap font. Encoded by libpng (simplified
+ * its range and the time in a built-in 5x7 bitmap font. Optionally a second panel below,
+ * the same frame coloured by particle size (log scale). Encoded by libpng (simplified
  * API, into memory) and written through rhod_write_bytes_atomic. */
 #include "rhod/io.h"
 
@@ -198,35 +199,20 @@ static void disc(canvas *c, unsigned fh, double cx, double cy, double r,
 
 static void fmt_value(char *buf, size_t len, double x) { snprintf(buf, len, "%.4g", x); }
 
-int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
-                       unsigned width, const double lo[2], const double hi[2], const double *range,
-                       char *err, size_t errlen) {
-  double ex = hi[0] - lo[0], ey = hi[1] - lo[1];
-  if (!(ex > 0) || !(ey > 0) || !isfinite(ex) || !isfinite(ey)) {
-    if (err && errlen)
-      snprintf(err, errlen, "%s: cannot draw: empty or invalid frame [%g, %g] x [%g, %g]", path,
-               lo[0], hi[0], lo[1], hi[1]);
-    return RHOD_ERR_SCENE;
-  }
-  double fhd = floor(width * ey / ex + 0.5);
-  if (width < 1 || width > MAX_SIDE || !(fhd <= MAX_SIDE)) {
-    if (err && errlen)
-      snprintf(err, errlen, "%s: cannot draw: picture size %u x %.0f outside 1..%u", path, width,
-               fhd, MAX_SIDE);
-    return RHOD_ERR_SCENE;
-  }
-  if ((int)field < RHOD_FIELD_PRESSURE || (int)field > RHOD_FIELD_FREE_SURFACE) {
-    if (err && errlen)
-      snprintf(err, errlen, "%s: cannot draw: unknown field %d", path, field);
-    return RHOD_ERR_SCENE;
-  }
-  if (v->n > 0 && (!v->x || !v->y || !v->size || !field_present(v, field))) {
-    if (err && errlen)
-      snprintf(err, errlen, "%s: cannot draw: a particle field is missing", path);
-    return RHOD_ERR_IO;
-  }
-  unsigned fh = fhd < 1 ? 1u : (unsigned)fhd;
+/* Where a value falls on the colour scale [vmin, vmax]: linear, or logarithmic for the
+ * particle size (levels are dx / 2^l: equal steps of colour per level). */
+static double scale_at(rhod_field field, double f, double vmin, double vmax) {
+  if (field == RHOD_FIELD_SIZE && vmin > 0 && vmax > vmin && f > 0)
+    return log(f / vmin) / log(vmax / vmin);
+  return vmax != vmin ? (f - vmin) / (vmax - vmin) : 0.0;
+}
 
+/* One panel at rows [y_off, y_off + fh + strip): the particles coloured by `field` in the
+ * frame [lo, hi], a grey rule, the colour bar and "min  field  t=...s  max". */
+static void draw_panel(canvas *c, long y_off, unsigned fh, int scale, const rhod_snapshot_view *v,
+                       rhod_field field, const double lo[2], const double hi[2],
+                       const double *range) {
+  const unsigned width = c->w;
   /* Field values and their range. */
   double vmin = 0, vmax = 0;
   if (range) {
@@ -245,23 +231,9 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
       any = 1;
     }
   }
-  double span = vmax - vmin;
-
-  /* Layout: frame rows [0, fh), a grey rule, then the strip. */
-  int scale = width >= 1200 ? 3 : width >= 600 ? 2 : 1;
-  int pad = 3 * scale, bar_h = 8 * scale, text_h = 7 * scale;
-  unsigned strip = (unsigned)(1 + pad + bar_h + pad + text_h + pad);
-  canvas c = {NULL, width, fh + strip};
-  size_t bytes = (size_t)3 * c.w * c.h;
-  c.px = malloc(bytes);
-  if (!c.px) {
-    if (err && errlen)
-      snprintf(err, errlen, "%s: cannot draw: out of memory", path);
-    return RHOD_ERR_MEMORY;
-  }
-  memset(c.px, 255, bytes);
-
-  double sx = width / ex, sy = fh / ey;
+  /* the frame, drawn into a view of the canvas that starts at row y_off */
+  canvas f = {c->px + 3 * (size_t)y_off * width, width, c->h - (unsigned)y_off};
+  const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], sx = width / ex, sy = fh / ey;
   static const unsigned char grey[3] = {160, 160, 160};
   for (size_t i = 0; i < v->n; i++) {
     double cx = ((double)v->x[i] - lo[0]) * sx, cy = (hi[1] - (double)v->y[i]) * sy;
@@ -274,19 +246,20 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
       r = 2.0 * (width + fh);
     if (cx + r < 0 || cy + r < 0 || cx - r > width || cy - r > fh)
       continue;
-    double f = field_value(v, field, i);
+    double val = field_value(v, field, i);
     unsigned char rgb[3];
-    if (!isfinite(f))
+    if (!isfinite(val))
       memcpy(rgb, grey, 3);
     else
-      colour_at(span != 0 ? (f - vmin) / span : 0.0, rgb);
-    disc(&c, fh, cx, cy, r, rgb);
+      colour_at(scale_at(field, val, vmin, vmax), rgb);
+    disc(&f, fh, cx, cy, r, rgb);
   }
 
   /* The strip: a rule, the colour bar, then "min   field  t=...s   max". */
+  int pad = 3 * scale, bar_h = 8 * scale;
   static const unsigned char rule[3] = {200, 200, 200};
   for (unsigned i = 0; i < width; i++)
-    put(&c, i, fh, rule);
+    put(&f, i, fh, rule);
   long y0 = (long)fh + 1 + pad, x0 = pad, x1 = (long)width - pad;
   if (x1 <= x0) {
     x0 = 0;
@@ -296,21 +269,72 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
     unsigned char rgb[3];
     colour_at(x1 - x0 > 1 ? (double)(i - x0) / (double)(x1 - x0 - 1) : 0.0, rgb);
     for (long j = y0; j < y0 + bar_h; j++)
-      put(&c, i, j, rgb);
+      put(&f, i, j, rgb);
   }
   long ty = y0 + bar_h + pad;
   char smin[32], smax[32], mid[64];
   fmt_value(smin, sizeof smin, vmin);
   fmt_value(smax, sizeof smax, vmax);
-  snprintf(mid, sizeof mid, "%s  t=%.6gs", field_label(field), v->time);
+  snprintf(mid, sizeof mid, "%s%s  t=%.6gs", field_label(field),
+           field == RHOD_FIELD_SIZE && vmin > 0 ? " (log)" : "", v->time);
   long wmin = text_width(smin, scale), wmax = text_width(smax, scale);
   long wmid = text_width(mid, scale);
-  draw_text(&c, x0, ty, scale, smin);
+  draw_text(&f, x0, ty, scale, smin);
   if (x1 - wmax > x0 + wmin + 2 * scale)
-    draw_text(&c, x1 - wmax, ty, scale, smax);
+    draw_text(&f, x1 - wmax, ty, scale, smax);
   long mx = ((long)width - wmid) / 2;
   if (mx > x0 + wmin + 2 * scale && mx + wmid + 2 * scale < x1 - wmax)
-    draw_text(&c, mx, ty, scale, mid);
+    draw_text(&f, mx, ty, scale, mid);
+}
+
+int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
+                       int size_panel, unsigned width, const double lo[2], const double hi[2],
+                       const double *range, char *err, size_t errlen) {
+  double ex = hi[0] - lo[0], ey = hi[1] - lo[1];
+  if (!(ex > 0) || !(ey > 0) || !isfinite(ex) || !isfinite(ey)) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot draw: empty or invalid frame [%g, %g] x [%g, %g]", path,
+               lo[0], hi[0], lo[1], hi[1]);
+    return RHOD_ERR_SCENE;
+  }
+  const unsigned panels = size_panel && field != RHOD_FIELD_SIZE ? 2 : 1;
+  double fhd = floor(width * ey / ex + 0.5);
+  if (width < 1 || width > MAX_SIDE || !(fhd * panels <= MAX_SIDE)) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot draw: picture size %u x %.0f outside 1..%u", path, width,
+               fhd * panels, MAX_SIDE);
+    return RHOD_ERR_SCENE;
+  }
+  if ((int)field < RHOD_FIELD_PRESSURE || (int)field > RHOD_FIELD_FREE_SURFACE) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot draw: unknown field %d", path, field);
+    return RHOD_ERR_SCENE;
+  }
+  if (v->n > 0 && (!v->x || !v->y || !v->size || !field_present(v, field))) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot draw: a particle field is missing", path);
+    return RHOD_ERR_IO;
+  }
+  unsigned fh = fhd < 1 ? 1u : (unsigned)fhd;
+
+  /* Layout: per panel, frame rows [0, fh), a grey rule, then the strip; with the size
+   * panel (paper 002 Figs. 11, 17, 19 show the sizes beside the fields) the same frame
+   * coloured by size below the field's. */
+  int scale = width >= 1200 ? 3 : width >= 600 ? 2 : 1;
+  int pad = 3 * scale, bar_h = 8 * scale, text_h = 7 * scale;
+  unsigned strip = (unsigned)(1 + pad + bar_h + pad + text_h + pad);
+  canvas c = {NULL, width, panels * (fh + strip)};
+  size_t bytes = (size_t)3 * c.w * c.h;
+  c.px = malloc(bytes);
+  if (!c.px) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot draw: out of memory", path);
+    return RHOD_ERR_MEMORY;
+  }
+  memset(c.px, 255, bytes);
+  draw_panel(&c, 0, fh, scale, v, field, lo, hi, range);
+  if (panels == 2)
+    draw_panel(&c, (long)(fh + strip), fh, scale, v, RHOD_FIELD_SIZE, lo, hi, NULL);
 
   /* Encode into memory, then write atomically. */
   png_image img;

@@ -153,6 +153,7 @@ typedef struct {
   y_region *regions;
   unsigned n_regions;
   bool *dynamic, *free_surface, *walls, *coalesce;
+  int *pattern;
   y_refine_field *field;
 } y_refinement;
 
@@ -167,6 +168,7 @@ typedef struct {
   double *width;
   double *range;
   y_rect *box;
+  bool *size_panel;
 } y_picture;
 
 typedef struct {
@@ -233,6 +235,10 @@ static const cyaml_strval_t field_names[] = {
 static const cyaml_strval_t quantity_names[] = {
     {"pressure", RHOD_QTY_PRESSURE},
     {"dynamic_pressure", RHOD_QTY_DYNAMIC_PRESSURE},
+};
+static const cyaml_strval_t pattern_names[] = {
+    {"square", RHOD_PATTERN_SQUARE},
+    {"triangle", RHOD_PATTERN_TRIANGLE},
 };
 static const char *const probe_kind_names[] = {
     "pressure", "kinetic_energy", "potential_energy", "front",
@@ -386,6 +392,7 @@ static const cyaml_schema_field_t f_picture[] = {
     NUM_OPT("width", y_picture, width),
     VEC("range", OPT, y_picture, range),
     CYAML_FIELD_MAPPING_PTR("box", OPT | CYAML_FLAG_FLOW, y_picture, box, f_rect),
+    BOOL_OPT("size_panel", y_picture, size_panel),
     CYAML_FIELD_END,
 };
 
@@ -408,6 +415,7 @@ static const cyaml_schema_field_t f_refine_field[] = {
 
 static const cyaml_schema_field_t f_refinement[] = {
     NUM_OPT("levels", y_refinement, levels),
+    ENUM_OPT("pattern", y_refinement, pattern, pattern_names),
     CYAML_FIELD_SEQUENCE_COUNT("regions", OPT, y_refinement, regions, n_regions, &sch_region, 0,
                                CYAML_UNLIMITED),
     BOOL_OPT("dynamic", y_refinement, dynamic),
@@ -1234,10 +1242,15 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
     return fail(c, "refinement.levels", "must be a whole number in [1, %d], got %g",
                 RHOD_MAX_LEVELS, levels);
   s->levels = (int)levels;
+  s->pattern = r && r->pattern ? (rhod_pattern)*r->pattern : RHOD_PATTERN_SQUARE;
   s->refine_dynamic = s->levels > 1 && opt_bool(r ? r->dynamic : NULL, 1);
   s->refine_free_surface = opt_bool(r ? r->free_surface : NULL, 0);
   s->refine_walls = opt_bool(r ? r->walls : NULL, 0);
   s->refine_coalesce = opt_bool(r ? r->coalesce : NULL, 0);
+  if (r && r->n_regions && s->pattern != RHOD_PATTERN_SQUARE)
+    return fail(c, "refinement.regions",
+                "need refinement.pattern: square (initial levels are nested lattices, "
+                "halved in each region); with triangle the criteria refine at t = 0");
   if (r && r->n_regions) {
     s->regions = calloc(r->n_regions, sizeof *s->regions);
     if (!s->regions)
@@ -1494,6 +1507,9 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     return fail(c, "output.picture.width", "must be a whole number of pixels in [64, 8192], got %g",
                 width);
   s->picture_width = (unsigned)width;
+  /* with refinement, the sizes beside the field unless the field is the size */
+  s->picture_size_panel =
+      opt_bool(pic ? pic->size_panel : NULL, s->levels > 1) && s->picture_field != RHOD_FIELD_SIZE;
   if (pic && pic->range) {
     s->picture_range_set = 1;
     s->picture_range[0] = pic->range[0];
@@ -1735,6 +1751,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
   }
   m = tb_coll(&t, root, "refinement", RY_MAP, 0);
   tb_num(&t, m, "levels", s->levels);
+  tb_word(&t, m, "pattern",
+          strval_name(pattern_names, CYAML_ARRAY_LEN(pattern_names), (int)s->pattern));
   e = tb_coll(&t, m, "regions", RY_SEQ, s->n_regions == 0);
   for (unsigned i = 0; i < s->n_regions; i++) {
     ry_node *r = tb_coll(&t, e, NULL, RY_MAP, 0);
@@ -1760,6 +1778,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_word(&t, m, "field",
           strval_name(field_names, CYAML_ARRAY_LEN(field_names), (int)s->picture_field));
   tb_num(&t, m, "width", s->picture_width);
+  tb_bool(&t, m, "size_panel", s->picture_size_panel);
   if (s->picture_range_set)
     tb_vec(&t, m, "range", s->picture_range);
   if (s->picture_box_set) {

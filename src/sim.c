@@ -284,7 +284,14 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     }
   }
   s->margin = sc->radius_ratio * sc->dx; /* particles.dx is the coarsest size (level 0) */
+  /* the finest size (triangle: by the multiplications the splits make) */
   s->dx_min = ldexp(sc->dx, -(sc->levels - 1));
+  if (sc->pattern == RHOD_PATTERN_TRIANGLE) {
+    real dmin = (real)sc->dx;
+    for (int l = 1; l < sc->levels; l++)
+      dmin *= (real)(1 / rhod_pattern_ratio(sc->pattern));
+    s->dx_min = dmin;
+  }
   /* Wall mirrors: a fluid particle's ghost is needed by every particle whose support
    * crosses the wall. With one size that is within R_i of the wall; with mixed sizes
    * a neighbour may be up to twice as large (criterion 1 keeps sizes in a support

@@ -242,37 +242,43 @@ static long split_round(run *r) {
 
 /* One split round (criterion 3) on the tank: the runs start from the same lattice
  * (dynamic: false, so no t = 0 cascade, whose particles get the exact initial fields
- * at their places, src/sim.c restate_initial). */
-static void test_split_conservation(void) {
+ * at their places, src/sim.c restate_initial). The square pattern (1 -> 4, children
+ * dx/2) or the triangle (1 -> 3, dx/sqrt 3). */
+static void split_conservation(const char *pattern) {
   run one, two;
+  char yaml[1024];
+  snprintf(yaml, sizeof yaml,
+           TANK_SCENE "refinement: {levels: 2, free_surface: true, dynamic: false, pattern: %s}\n",
+           pattern);
+  const int tri = strcmp(pattern, "triangle") == 0, N = tri ? 3 : 4;
   const int ok1 = run_open(&one, "tank1", TANK_SCENE);
-  const int ok2 = run_open(
-      &two, "tank2", TANK_SCENE "refinement: {levels: 2, free_surface: true, dynamic: false}\n");
+  const int ok2 = run_open(&two, "tank2", yaml);
   CU_ASSERT_FATAL(ok1 && ok2);
   CU_ASSERT(split_round(&two) > 0);
   rhod_snapshot_view a, b;
   rhod_sim_fetch(one.sim, &a);
   rhod_sim_fetch(two.sim, &b);
   const double dx = 0.01;
+  const real child = tri ? (real)dx * (real)(1 / sqrt(3.0)) : (real)(dx / 2);
   CU_ASSERT_EQUAL(a.n, 200);
-  /* sizes: dx or dx / 2, never below dx_min */
+  /* sizes: dx or dx / e, never below dx_min */
   long coarse = 0, fine = 0, other = 0, fine_deep = 0;
   for (size_t i = 0; i < b.n; i++) {
     if (b.size[i] == (real)dx)
       coarse++;
-    else if (b.size[i] == (real)(dx / 2))
+    else if (b.size[i] == child)
       fine++, fine_deep += b.y[i] < 0.1 - 6 * dx; /* criterion 3: only near the surface */
     else
       other++;
     CU_ASSERT(b.size[i] >= (real)two.sim->dx_min);
   }
   CU_ASSERT_EQUAL(other, 0);
-  CU_ASSERT_DOUBLE_EQUAL(two.sim->dx_min, dx / 2, 1e-18);
-  /* every fine particle is one of the 4 children of a split, which adds 3 */
-  CU_ASSERT_EQUAL(fine % 4, 0);
-  CU_ASSERT_EQUAL((long)b.n, (long)a.n + 3 * (fine / 4));
-  CU_ASSERT_EQUAL(coarse + fine / 4, (long)a.n);
-  CU_ASSERT(fine >= 4 * 40); /* the top rows were split ... */
+  CU_ASSERT_DOUBLE_EQUAL(two.sim->dx_min, (double)child, 1e-18);
+  /* every fine particle is one of the N children of a split, which adds N - 1 */
+  CU_ASSERT_EQUAL(fine % N, 0);
+  CU_ASSERT_EQUAL((long)b.n, (long)a.n + (N - 1) * (fine / N));
+  CU_ASSERT_EQUAL(coarse + fine / N, (long)a.n);
+  CU_ASSERT(fine >= N * 40); /* the top rows were split ... */
   CU_ASSERT(coarse >= 80);   /* ... and the bottom rows were not */
   CU_ASSERT_EQUAL(fine_deep, 0);
   CU_ASSERT_EQUAL(two.sim->p.next_id, (uint64_t)b.n);
@@ -289,6 +295,9 @@ static void test_split_conservation(void) {
   run_close(&one);
   run_close(&two);
 }
+
+static void test_split_conservation(void) { split_conservation("square"); }
+static void test_split_conservation_triangle(void) { split_conservation("triangle"); }
 
 /* Children are kept off the walls: a jittered lattice (parents a quarter to three
  * quarters of dx from the walls) split everywhere (criterion 5 with no bound). The
@@ -586,6 +595,135 @@ static void test_split_geometry(void) {
   free(sc);
 }
 
+/* The 1 -> 3 triangle of the Appendix (Fig. 32), on the jittered lattice of
+ * test_split_geometry with every 5th particle split: three children of size dx/sqrt 3
+ * and mass m/3 at the corners of the equilateral triangle of side dx/sqrt 3 (their
+ * size) centred on the parent, each with the pressure projected to where it stands.
+ * The orientation scores at least as well as the triangle with a corner towards the
+ * nearest neighbour (the score of test_split_geometry), and the search turns some. */
+static void test_split_triangle(void) {
+  const double dx = 0.01, c0 = 20, rho0 = 1000, side = dx / sqrt(3.0), rt = dx / 3;
+  rhod_scene *sc = unit_scene(dx);
+  sc->pattern = RHOD_PATTERN_TRIANGLE;
+  rhod_particles p;
+  const int nx = 20, ny = 20;
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, (size_t)(nx * ny) + 8), RHOD_OK);
+  unsigned long seed = 11;
+  add_block(&p, 0, 0, nx, ny, dx, 0.5, &seed);
+  const long n0 = (long)p.n;
+  const double ga = -1500, gb = 3000, gc = 200;
+  for (long i = 0; i < n0; i++) {
+    p.rho[i] = (real)(rho0 + (ga * p.x[i] + gb * p.y[i] + gc) / (c0 * c0));
+    p.m[i] = (real)(p.rho[i] * dx * dx);
+    p.ux[i] = (real)(0.2 + 0.001 * i), p.uy[i] = (real)(0.05 - 0.003 * i);
+  }
+  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
+  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
+  rhod_sph s;
+  rhod_cells c;
+  rhod_apr a;
+  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, side);
+  CU_ASSERT_EQUAL(a.nsplit, 3);
+  uint8_t *want = calloc((size_t)n0, 1);
+  real *before = malloc(6 * (size_t)n0 * sizeof(real));
+  real *e = malloc(2 * (size_t)n0 * sizeof(real));
+  long k = 0;
+  for (long i = 0; i < n0; i++) {
+    want[i] = i % 5 == 2, k += want[i];
+    const real v[6] = {p.x[i], p.y[i], p.ux[i], p.uy[i], p.rho[i], p.m[i]};
+    memcpy(before + 6 * i, v, sizeof v);
+    double best = HUGE_VAL;
+    for (long j = 0; j < n0; j++) {
+      const double rx = p.x[j] - p.x[i], ry = p.y[j] - p.y[i], r = hypot(rx, ry);
+      if (j != i && r < best)
+        best = r, e[2 * i] = (real)(rx / r), e[2 * i + 1] = (real)(ry / r);
+    }
+  }
+  memcpy(a.mark, want, (size_t)n0);
+  rhod_to_device(a.mark, (size_t)n0);
+  const long split = rhod_apr_split(&a, &s, &p, &nowalls);
+  rhod_particles_to_host(&p);
+  CU_ASSERT_EQUAL(split, k);
+  CU_ASSERT_EQUAL_FATAL((long)p.n, n0 + 2 * k);
+  long wrong_count = 0, wrong_state = 0, wrong_pressure = 0, worse = 0, turned = 0;
+  double eside = 0, ecentre = 0;
+  const real child = (real)dx * (real)(1 / sqrt(3.0)), third = (real)1 / (real)3;
+  for (long i = 0; i < n0; i++) {
+    if (!want[i])
+      continue;
+    const real *B = before + 6 * i;
+    long ch[3], nc = 0;
+    for (long j = 0; j < (long)p.n; j++)
+      if (p.ux[j] == B[2] && p.uy[j] == B[3]) {
+        if (nc < 3)
+          ch[nc] = j;
+        nc++;
+      }
+    if (nc != 3) {
+      wrong_count++;
+      continue;
+    }
+    double ox[3], oy[3], cx = 0, cy = 0;
+    for (int q = 0; q < 3; q++) {
+      const long j = ch[q];
+      wrong_state += p.m[j] != third * B[5] || p.dx[j] != child;
+      ox[q] = p.x[j] - B[0], oy[q] = p.y[j] - B[1];
+      cx += ox[q] / 3, cy += oy[q] / 3;
+      const double Pc = ((double)p.rho[j] - rho0) * c0 * c0;
+      wrong_pressure += fabs(Pc - (ga * p.x[j] + gb * p.y[j] + gc)) > TOL(1e-5) * 1e4;
+    }
+    ecentre = fmax(ecentre, hypot(cx, cy) / dx);
+    for (int q = 0; q < 3; q++)
+      eside =
+          fmax(eside, fabs(hypot(ox[(q + 1) % 3] - ox[q], oy[(q + 1) % 3] - oy[q]) - side) / dx);
+    /* the triangle with a corner along e */
+    const double c120 = -0.5, s120 = sqrt(3.0) / 2;
+    double tx[3], ty[3];
+    for (int q = 0; q < 3; q++) {
+      const double cq = q == 0 ? 1 : c120, sq = q == 0 ? 0 : (q == 1 ? s120 : -s120);
+      tx[q] = rt * (cq * e[2 * i] - sq * e[2 * i + 1]);
+      ty[q] = rt * (cq * e[2 * i + 1] + sq * e[2 * i]);
+    }
+    double s_got = side, s_tri = side;
+    for (long j = 0; j < n0; j++) {
+      const real *Bj = before + 6 * j;
+      const double rx = Bj[0] - B[0], ry = Bj[1] - B[1], r = hypot(rx, ry);
+      if (j == i || r >= 2 * dx)
+        continue;
+      for (int q = 0; q < 3; q++) {
+        s_got = fmin(s_got, 2 * (0.5 * r - (ox[q] * rx + oy[q] * ry) / r));
+        s_tri = fmin(s_tri, 2 * (0.5 * r - (tx[q] * rx + ty[q] * ry) / r));
+      }
+    }
+    int aligned = 1;
+    for (int q = 0; q < 3; q++) {
+      int found = 0;
+      for (int t = 0; t < 3; t++)
+        found |= hypot(ox[q] - tx[t], oy[q] - ty[t]) < TOL(1e-12) * dx;
+      aligned &= found;
+    }
+    worse += s_got < s_tri - TOL(1e-12) * dx;
+    turned += !aligned;
+  }
+  printf("\ntriangle: %ld split, %ld turned from the nearest neighbour\n", k, turned);
+  CU_ASSERT(k > 50);
+  CU_ASSERT_EQUAL(wrong_count, 0);
+  CU_ASSERT_EQUAL(wrong_state, 0);
+  CU_ASSERT_EQUAL(wrong_pressure, 0);
+  CU_ASSERT(eside < TOL(1e-12));
+  CU_ASSERT(ecentre < TOL(1e-12));
+  CU_ASSERT_EQUAL(worse, 0);
+  CU_ASSERT(turned > 0);
+  free(want);
+  free(before);
+  free(e);
+  rhod_apr_free(&a);
+  rhod_cells_free(&c);
+  rhod_particles_free(&p);
+  free(sc);
+}
+
 /* A strained lattice, as a dam break's stretching leaves it: rows 2.5 dx apart, particles
  * 0.4 dx apart along them (the same area per particle). Split everywhere, the paper's
  * square turned to the nearest neighbour would put each child 0.1 dx from a neighbour's
@@ -736,23 +874,29 @@ static void test_criteria_1_2(void) {
 /* ------------------------------------------------------------------------------------ */
 /* 7. coalescing: groups on a hand-made store, then whole runs                           */
 
-/* A fine lattice (dx/2, 24 x 24) beside a coarse one (dx, 8 x 12) and one particle of
- * dx/4 inside the fine block, a linear velocity field and a pressure gradient.
+/* A fine lattice (h = dx/e, 24 x 24) beside a coarse one (dx, 8 x 12) and one particle
+ * of h/e inside the fine block, a linear velocity field and a pressure gradient.
  * Coalescing with criteria 1 and 2 only: the fine particles group into the lattice's
- * 2 x 2 blocks, except within 2 R (the merged particle's support) of the dx/4 one,
- * which would be the merged particle's grandchild (criterion 1); the merge keeps
- * mass, momentum, centre of mass and volume. */
-static void test_coalesce_groups(void) {
-  const double dx = 0.01, h = dx / 2, c0 = 20, rho0 = 1000;
+ * 2 x 2 blocks (square pattern; triangle: groups of three within dx of their centre),
+ * except within e R (the merged particle's support) of the h/e one, which would be
+ * the merged particle's grandchild (criterion 1); the merge keeps mass, momentum,
+ * centre of mass and volume, and the merged particles have the size dx exactly. */
+static void coalesce_groups(rhod_pattern pattern) {
+  const int N = rhod_pattern_children(pattern);
+  const double dx = 0.01, eps = rhod_pattern_ratio(pattern), h = dx / eps, c0 = 20, rho0 = 1000;
   rhod_scene *sc = unit_scene(dx);
   sc->refine_coalesce = 1;
+  sc->pattern = pattern;
   rhod_particles p;
   CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, 800), RHOD_OK);
   unsigned long seed = 5;
-  add_block(&p, 0, 0, 24, 24, h, 0, &seed);       /* x in [0, 12 dx) */
-  add_block(&p, 12 * dx, 0, 8, 12, dx, 0, &seed); /* x in [12, 20) dx */
+  const double xc = 24 * h;                 /* the fine block: x in [0, 24 h) */
+  add_block(&p, 0, 0, 24, 24, h, 0, &seed); /* the fine sizes: (real)h, as a split makes them */
+  for (size_t i = 0; i < p.n; i++)
+    p.dx[i] = (real)dx * (real)(1 / eps);
+  add_block(&p, xc, 0, 8, 12, dx, 0, &seed); /* x in [24 h, 24 h + 8 dx) */
   const long tiny = (long)p.n;
-  add_block(&p, 3 * dx - h / 4, 6 * dx - h / 4, 1, 1, h / 2, 0, &seed); /* at (3, 6) dx */
+  add_block(&p, 3 * dx - h / (2 * eps), 6 * dx - h / (2 * eps), 1, 1, h / eps, 0, &seed);
   const long n0 = (long)p.n;
   for (long i = 0; i < n0; i++) {
     p.ux[i] = (real)(0.3 + 5 * p.y[i]), p.uy[i] = (real)(-0.1 + 7 * p.x[i]);
@@ -765,11 +909,11 @@ static void test_coalesce_groups(void) {
     M0 += p.m[i], PX0 += p.m[i] * p.ux[i], PY0 += p.m[i] * p.uy[i];
     X0 += p.m[i] * p.x[i], Y0 += p.m[i] * p.y[i], V0 += p.m[i] / p.rho[i];
   }
-  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {28 * dx, 20 * dx};
+  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {xc + 16 * dx, 20 * dx};
   rhod_sph s;
   rhod_cells c;
   rhod_apr a;
-  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
+  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, h);
   /* again with coalescing (mark_store marked without) */
   CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&a, &s, &p, &c, &nowalls, 0, 1), RHOD_OK);
   rhod_to_host(a.mark, (size_t)n0);
@@ -780,25 +924,29 @@ static void test_coalesce_groups(void) {
     coarse_marked += p.dx[i] == (real)dx && a.mark[i] > 1;
     split += a.mark[i] == 1;
     members += a.mark[i] == 4;
-    near += a.mark[i] >= 2 && hypot(p.x[i] - p.x[tiny], p.y[i] - p.y[tiny]) < 8 * h;
+    /* the merged particle's support: e R_h = 4 dx */
+    near += a.mark[i] >= 2 && hypot(p.x[i] - p.x[tiny], p.y[i] - p.y[tiny]) < 4 * dx;
     if (a.mark[i] != 3)
       continue;
     leaders++;
-    /* a 2 x 2 block of the lattice: 4 distinct fine particles, 0.71 h from their centre */
+    /* N distinct fine particles; square: a 2 x 2 block of the lattice, 0.71 h from
+     * their centre; triangle: within dx of it, a group of three holds no fourth slot */
     double cx = 0, cy = 0;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < N; k++) {
       const int32_t j = a.grp[4 * i + k];
-      cx += 0.25 * p.x[j], cy += 0.25 * p.y[j];
-      bad_group += p.dx[j] != (real)h || (k > 0 && a.mark[j] != 4) || owner[j]++ > 0;
+      cx += p.x[j] / N, cy += p.y[j] / N;
+      bad_group += p.dx[j] != p.dx[i] || (k > 0 && a.mark[j] != 4) || owner[j]++ > 0;
     }
-    for (int k = 0; k < 4; k++) {
+    bad_group += N == 3 && a.grp[4 * i + 3] != -1;
+    for (int k = 0; k < N; k++) {
       const int32_t j = a.grp[4 * i + k];
-      bad_group += fabs(hypot(p.x[j] - cx, p.y[j] - cy) - h * 0.70710678118654752) > TOL(1e-9) * h;
+      const double d = hypot(p.x[j] - cx, p.y[j] - cy);
+      bad_group += N == 4 ? fabs(d - h * 0.70710678118654752) > TOL(1e-9) * h : d > dx;
     }
   }
-  printf("\ncoalescing: %ld groups of the %d fine particles\n", leaders, 24 * 24);
-  CU_ASSERT(leaders >= 60); /* of the 144 blocks, about 50 lie within 2 R of the dx/4 one */
-  CU_ASSERT_EQUAL(members, 3 * leaders);
+  printf("\ncoalescing: %ld groups of %d of the %d fine particles\n", leaders, N, 24 * 24);
+  CU_ASSERT(leaders >= 60); /* square: of the 144 blocks, about 50 lie within 2 R of the tiny */
+  CU_ASSERT_EQUAL(members, (N - 1) * leaders);
   CU_ASSERT_EQUAL(bad_group, 0);
   CU_ASSERT_EQUAL(coarse_marked, 0); /* dx is the coarsest size */
   CU_ASSERT_EQUAL(near, 0);
@@ -806,13 +954,13 @@ static void test_coalesce_groups(void) {
   CU_ASSERT_EQUAL(rhod_apr_split(&a, &s, &p, &nowalls), 0);
   CU_ASSERT_EQUAL(rhod_apr_coalesce(&a, &p), leaders);
   rhod_particles_to_host(&p);
-  CU_ASSERT_EQUAL((long)p.n, n0 - 3 * leaders);
+  CU_ASSERT_EQUAL((long)p.n, n0 - (N - 1) * leaders);
   double M1 = 0, PX1 = 0, PY1 = 0, X1 = 0, Y1 = 0, V1 = 0;
   long grown = 0, gone = 0;
   for (long i = 0; i < (long)p.n; i++) {
     M1 += p.m[i], PX1 += p.m[i] * p.ux[i], PY1 += p.m[i] * p.uy[i];
     X1 += p.m[i] * p.x[i], Y1 += p.m[i] * p.y[i], V1 += p.m[i] / p.rho[i];
-    grown += p.dx[i] == (real)dx && p.x[i] < 12 * dx;
+    grown += p.dx[i] == (real)dx && p.x[i] < xc;
     gone += a.mark[p.id[i]] == 4; /* the store is unsorted here: id = old index */
   }
   CU_ASSERT_EQUAL(grown, leaders);
@@ -832,6 +980,9 @@ static void test_coalesce_groups(void) {
   rhod_particles_free(&p);
   free(sc);
 }
+
+static void test_coalesce_groups(void) { coalesce_groups(RHOD_PATTERN_SQUARE); }
+static void test_coalesce_groups_triangle(void) { coalesce_groups(RHOD_PATTERN_TRIANGLE); }
 
 /* A tank at rest with a refined block (level 1) in the bulk and no criterion asking
  * for it: with coalescing the block merges back from its edges (the merged particle
@@ -896,6 +1047,53 @@ static void test_coalesce_run(void) {
     }
     run_close(&r);
   }
+}
+
+/* A collapsing column with the triangle (three levels: dx, dx/sqrt 3, dx/3), criterion 3
+ * and coalescing: every size is one of the three level sizes exactly (as the splits and
+ * the merges make them), both finer levels are present, every split adds two particles
+ * and every merge removes two, mass stays and ids stay distinct. */
+static void test_triangle_run(void) {
+  run r;
+  CU_ASSERT_FATAL(run_open(&r, "tri",
+                           "time: {end: 1, output_every: 1}\n"
+                           "particles: {dx: 0.012}\n"
+                           "physics: {c0: 15, gravity: [0, -9.81]}\n"
+                           "fluid:\n"
+                           "  - rect: {min: [0, 0], max: [0.2, 0.2]}\n"
+                           "    pressure: hydrostatic\n"
+                           "walls:\n"
+                           "  - rect: {min: [0, 0], max: [0.6, 0.3]}\n"
+                           "refinement: {levels: 3, pattern: triangle, free_surface: true, "
+                           "coalesce: true}\n"));
+  rhod_snapshot_view v;
+  rhod_sim_fetch(r.sim, &v);
+  const long n0 = (long)v.n;
+  const long double m0 = fluid_totals(&v).m;
+  /* dx = 0.012: in double, dx/3 * sqrt 3 != dx/sqrt 3 (the merge must not multiply) */
+  const real s0 = (real)0.012, s1 = s0 * (real)(1 / sqrt(3.0)), s2 = s1 * (real)(1 / sqrt(3.0));
+  char err[512] = "";
+  long other = 0;
+  for (int step = 0; step < 120; step++) {
+    CU_ASSERT_EQUAL_FATAL(rhod_sim_step(r.sim, r.sim->dt, err, sizeof err), RHOD_OK);
+    rhod_sim_fetch(r.sim, &v);
+    for (size_t i = 0; i < v.n; i++)
+      other += v.size[i] != s0 && v.size[i] != s1 && v.size[i] != s2;
+  }
+  long n1 = 0, n2 = 0;
+  for (size_t i = 0; i < v.n; i++)
+    n1 += v.size[i] == s1, n2 += v.size[i] == s2;
+  const long double m1 = fluid_totals(&v).m;
+  printf("\ntriangle run: %ld -> %zu particles (%ld at dx/sqrt 3, %ld at dx/3), %ld splits, "
+         "%ld merges\n",
+         n0, v.n, n1, n2, r.sim->apr.split_total, r.sim->apr.merged_total);
+  CU_ASSERT_EQUAL(other, 0);
+  CU_ASSERT(n1 > 0 && n2 > 0);
+  CU_ASSERT(r.sim->apr.split_total > 0);
+  CU_ASSERT_EQUAL((long)v.n, n0 + 2 * r.sim->apr.split_total - 2 * r.sim->apr.merged_total);
+  CU_ASSERT(fabsl(m1 - m0) <= TOL(1e-13) * m0);
+  CU_ASSERT(ids_unique(&v, r.sim->p.next_id));
+  run_close(&r);
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -1006,13 +1204,17 @@ int main(void) {
   static const rhod_test_case cases[] = {
       {"mixed-size neighbour search = brute force", test_mixed_size_neighbours},
       {"a split round conserves mass and momenta", test_split_conservation},
+      {"... also with the 1 -> 3 triangle", test_split_conservation_triangle},
       {"split geometry and children's state", test_split_geometry},
       {"split pattern on a strained lattice", test_split_strained_lattice},
+      {"the 1 -> 3 triangle: geometry and children's state", test_split_triangle},
       {"split children are kept off the walls", test_split_keeps_off_walls},
       {"dx_min is never crossed", test_dx_min_never_crossed},
       {"criteria 1 and 2", test_criteria_1_2},
       {"coalescing groups and conservation", test_coalesce_groups},
+      {"... also in groups of three (triangle)", test_coalesce_groups_triangle},
       {"coalescing in a run: merges back, never splits again", test_coalesce_run},
+      {"a run with the triangle: level sizes, splits and merges", test_triangle_run},
       {"snapshot free-surface flags, across levels and splits", test_free_surface_flags},
       {"levels 2 without splits = single resolution", test_equal_sizes_single_resolution},
       {"... also in a corner of the tank", test_equal_sizes_single_resolution_corner},

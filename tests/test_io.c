@@ -482,7 +482,7 @@ static void test_picture(void) {
   char err[512] = "";
   const char *path = spath("pressure.png");
   CU_ASSERT_EQUAL_FATAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 200, lo, hi, NULL, err, sizeof err),
+      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, NULL, err, sizeof err),
       RHOD_OK);
   CU_ASSERT(!exists(spath("pressure.png.tmp")));
   size_t len = 0;
@@ -527,7 +527,7 @@ static void test_picture(void) {
   /* a given range: p = 10 in [0, 20] is the middle stop */
   double range[2] = {0, 20};
   CU_ASSERT_EQUAL_FATAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 200, lo, hi, range, err, sizeof err),
+      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, range, err, sizeof err),
       RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
   CU_ASSERT(pixel_is(&im, 50, 50, 33, 144, 140));
@@ -540,29 +540,59 @@ static void test_picture(void) {
   P.uy[1] = 0;
   double r2[2] = {0, 5};
   CU_ASSERT_EQUAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_VELOCITY, 200, lo, hi, r2, err, sizeof err), RHOD_OK);
+      rhod_write_picture(path, &v, RHOD_FIELD_VELOCITY, 0, 200, lo, hi, r2, err, sizeof err),
+      RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
   CU_ASSERT(pixel_is(&im, 50, 50, 253, 231, 37));
   CU_ASSERT(pixel_is(&im, 150, 50, 68, 1, 84));
   free(im.px);
   v.fs = NULL;
   CU_ASSERT_EQUAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 100, lo, hi, NULL, err, sizeof err),
+      rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 0, 100, lo, hi, NULL, err, sizeof err),
       RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
   CU_ASSERT_EQUAL(im.w, 100);
   CU_ASSERT(pixel_is(&im, 25, 25, 68, 1, 84));
   free(im.px);
 
+  /* the size panel: the same frame below, coloured by size on a log scale over
+   * [0.001, 0.2]: particle 0 (0.2) the top colour, particle 3 (0.001) the bottom one,
+   * particle 2 (0.1) at log(100)/log(200) = 0.869 of the scale (between the stops
+   * (93, 200, 99) and (170, 220, 50)); the field's panel above unchanged */
+  const unsigned h1 = im.h;
+  CU_ASSERT_EQUAL_FATAL(
+      rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 1, 100, lo, hi, NULL, err, sizeof err),
+      RHOD_OK);
+  CU_ASSERT_FATAL(read_png(path, &im));
+  CU_ASSERT_EQUAL(im.h, 2 * h1);
+  CU_ASSERT(pixel_is(&im, 25, 25, 68, 1, 84));
+  CU_ASSERT(pixel_is(&im, 25, h1 + 25, 253, 231, 37));
+  CU_ASSERT(pixel_is(&im, 95, h1 + 45, 68, 1, 84));
+  {
+    const double t = log(100.0) / log(200.0) * 8 - 6;
+    const int r = (int)lround(93 + t * (170 - 93)), g = (int)lround(200 + t * (220 - 200)),
+              b = (int)lround(99 + t * (50 - 99));
+    CU_ASSERT(pixel_is(&im, 50, h1 + 5, r, g, b));
+  }
+  free(im.px);
+  /* no second panel when the field is the size itself */
+  CU_ASSERT_EQUAL_FATAL(
+      rhod_write_picture(path, &v, RHOD_FIELD_SIZE, 1, 100, lo, hi, NULL, err, sizeof err),
+      RHOD_OK);
+  CU_ASSERT_FATAL(read_png(path, &im));
+  CU_ASSERT_EQUAL(im.h, h1);
+  CU_ASSERT(pixel_is(&im, 25, 25, 253, 231, 37));
+  free(im.px);
+
   /* errors: an empty frame; a folder that does not exist (nothing left behind) */
   double bad_hi[2] = {0, 1};
   CU_ASSERT_EQUAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 200, lo, bad_hi, NULL, err, sizeof err),
+      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, bad_hi, NULL, err, sizeof err),
       RHOD_ERR_SCENE);
   CU_ASSERT_PTR_NOT_NULL(strstr(err, path));
   const char *nodir = spath("no_such_dir/p.png");
   CU_ASSERT_EQUAL(
-      rhod_write_picture(nodir, &v, RHOD_FIELD_PRESSURE, 200, lo, hi, NULL, err, sizeof err),
+      rhod_write_picture(nodir, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, NULL, err, sizeof err),
       RHOD_ERR_IO);
   CU_ASSERT_PTR_NOT_NULL(strstr(err, nodir));
   free_particles(&P);
@@ -590,8 +620,8 @@ static void test_picture_speed(void) {
   double lo[2] = {0, 0}, hi[2] = {4, 2};
   char err[512];
   double t0 = now();
-  int rc = rhod_write_picture(spath("speed.png"), &v, RHOD_FIELD_PRESSURE, 800, lo, hi, NULL, err,
-                              sizeof err);
+  int rc = rhod_write_picture(spath("speed.png"), &v, RHOD_FIELD_PRESSURE, 0, 800, lo, hi, NULL,
+                              err, sizeof err);
   double dt = now() - t0;
   CU_ASSERT_EQUAL(rc, RHOD_OK);
   printf("\n    picture of 1e5 particles at 800 px: %.1f ms ", 1e3 * dt);

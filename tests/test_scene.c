@@ -316,6 +316,8 @@ static const struct {
     {"refine_free_surface_no_detection.yaml", 14, "refinement.free_surface",
      "needs the free-surface detection"},
     {"refine_coalesce_static.yaml", 13, "refinement.coalesce", "needs dynamic refinement"},
+    {"refine_pattern_unknown.yaml", 12, "refinement.pattern", "hexagon"},
+    {"refine_triangle_regions.yaml", 14, "refinement.regions", "need refinement.pattern: square"},
     {"refine_levels_fraction.yaml", 11, "refinement.levels", "whole number"},
     {"refine_levels_zero.yaml", 11, "refinement.levels", "whole number"},
     {"refine_region_level.yaml", 14, "refinement.regions.0.level", "whole number"},

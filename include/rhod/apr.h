@@ -1,13 +1,14 @@
 /* Adaptive particle refinement of paper 002 (Michel et al. 2025), Sec. V: the
  * refinement criteria (Sec. V B), evaluated during the last stage of a step, and the
- * 1 -> 4 split (Sec. V A) applied before the next one: mark, scan, append, then the
- * engine re-sorts at the next step. Sizes are particles.dx / 2^l, l < levels.
+ * 1 -> 4 split (Sec. V A; or 1 -> 3, Appendix) applied before the next one: mark,
+ * scan, append, then the engine re-sorts at the next step. Sizes are particles.dx /
+ * e^l, l < levels, e = 2 (square pattern) or sqrt 3 (triangle).
  *
  * Coalescing (not in paper 002, which leaves it to future work; paper 004 Sec. 2.3
- * merges the nearest small particles at their centre of mass): four particles of a
- * level where no criterion would refine their parent any more merge back into one of
- * twice their size, conserving mass, momentum and volume. Marked in the same pass
- * (candidates, then groups), applied after the split: combine, scan, compact. */
+ * merges the nearest small particles at their centre of mass): four (triangle: three)
+ * particles of a level where no criterion would refine their parent any more merge
+ * back into one of the next coarser size, conserving mass, momentum and volume. Marked in the same
+ * pass (candidates, then groups), applied after the split: combine, scan, compact. */
 #ifndef RHOD_APR_H
 #define RHOD_APR_H
 
@@ -25,8 +26,10 @@ typedef struct {
   int field;        /* criterion 5 */
   rhod_quantity qty;
   real above, below, from;
-  int coalesce; /* refinement.coalesce */
-  real dx_max;  /* no particle grows beyond this size (particles.dx) */
+  int nsplit;     /* children per split: 4 (square pattern) or 3 (triangle) */
+  real eps, ieps; /* size ratio of adjacent levels (2 or sqrt 3) and its inverse */
+  int coalesce;   /* refinement.coalesce */
+  real dx_max;    /* no particle grows beyond this size (particles.dx) */
   /* Own buffers, not fields of the store: they must survive the store's growth
    * between marking and splitting. */
   size_t cap;
@@ -36,7 +39,8 @@ typedef struct {
   int32_t *cnt;   /* cap + 1: children written per particle, scanned */
   real *sd;       /* 4 cap: split data: grad P (Eq. 14), unit vector to the nearest neighbour */
   uint8_t *near2; /* cap: criterion 4 for the coalesced particle (wider support) */
-  int32_t *grp;   /* 4 cap: the group a candidate proposes (itself first) */
+  int32_t *grp;   /* 4 cap: the group a candidate proposes (itself first; -1 pads a
+                     group of three) */
   int32_t *claim; /* cap: the winning group containing a candidate, or -1 */
   uint8_t *acc;   /* cap: 1 = the candidate's proposed group was accepted */
   real *sp;       /* cap: the proposal's spread (smaller wins), or 1e30 for none */

@@ -57,13 +57,15 @@ int rhod_write_xdmf(const char *dir, int count, const double *times, const size_
                     char *err, size_t errlen);
 
 /* A PNG picture of one field: each particle a disc of its own size, coloured by a
- * perceptual colour map; the frame is the box [lo, hi]; a colour bar with its range
- * and the time are drawn. range NULL: auto (min/max of the field). The picture is width
- * pixels wide; below the frame is a strip with the bar and labels. Errors: RHOD_ERR_SCENE
- * (empty frame, width or height outside 1..16384), RHOD_ERR_IO (cannot write). */
+ * perceptual colour map (particle size: on a log scale); the frame is the box [lo, hi];
+ * a colour bar with its range and the time are drawn. range NULL: auto (min/max of the
+ * field). The picture is width pixels wide; below the frame is a strip with the bar and
+ * labels. size_panel (ignored when the field is the size): a second panel below, the
+ * same frame coloured by particle size. Errors: RHOD_ERR_SCENE (empty frame, width or
+ * height outside 1..16384), RHOD_ERR_IO (cannot write). */
 int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
-                       unsigned width, const double lo[2], const double hi[2], const double *range,
-                       char *err, size_t errlen);
+                       int size_panel, unsigned width, const double lo[2], const double hi[2],
+                       const double *range, char *err, size_t errlen);
 
 /* probes.csv: a header row (first column t) then one row per sample. The file is kept
  * open and flushed after every row. */

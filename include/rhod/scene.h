@@ -98,11 +98,25 @@ typedef enum {
   RHOD_FIELD_FREE_SURFACE
 } rhod_field;
 
-/* Most particle sizes a scene may use: dx, dx/2, ..., dx/2^(RHOD_MAX_LEVELS-1). */
+/* Most particle sizes a scene may use: dx, dx/e, ..., dx/e^(RHOD_MAX_LEVELS-1). */
 #define RHOD_MAX_LEVELS 8
 
-/* An initial refinement region: the lattice inside it starts at `level` (size
- * particles.dx / 2^level), the finest region containing a point winning. */
+/* refinement.pattern: how a particle splits (paper 002 Sec. V A and Appendix, Fig. 32).
+ * Square: 1 -> 4, level size ratio e = dx_l / dx_(l+1) = 2 (the paper's pattern);
+ * triangle: 1 -> 3, e = sqrt 3 (the Appendix's choice for R/dx = 3). The children have
+ * the parent's area between them: e = sqrt(N_split). */
+typedef enum { RHOD_PATTERN_SQUARE = 0, RHOD_PATTERN_TRIANGLE } rhod_pattern;
+
+/* Children per split, and the size ratio of two adjacent levels. */
+static inline int rhod_pattern_children(rhod_pattern p) {
+  return p == RHOD_PATTERN_TRIANGLE ? 3 : 4;
+}
+static inline double rhod_pattern_ratio(rhod_pattern p) {
+  return p == RHOD_PATTERN_TRIANGLE ? 1.7320508075688772 : 2.0;
+}
+
+/* An initial refinement region (square pattern): the lattice inside it starts at
+ * `level` (size particles.dx / 2^level), the finest region containing a point winning. */
 typedef struct {
   rhod_shape shape;
   int level;
@@ -155,7 +169,8 @@ typedef struct {
   unsigned n_probes;
   double probe_every; /* probes.every [s]: sampling interval, default output_every/10 */
   /* refinement (adaptive particle refinement, paper 002 Secs. IV D and V): */
-  int levels;           /* refinement.levels: sizes dx ... dx/2^(levels-1), default 1 */
+  int levels;           /* refinement.levels: sizes dx ... dx/e^(levels-1), default 1 */
+  rhod_pattern pattern; /* refinement.pattern, default square (e = 2) */
   rhod_region *regions; /* refinement.regions: initial nested levels */
   unsigned n_regions;
   int refine_dynamic;              /* refinement.dynamic: split by the criteria during the run
@@ -171,6 +186,9 @@ typedef struct {
   /* output: */
   rhod_field picture_field; /* output.picture.field, default pressure */
   unsigned picture_width;   /* output.picture.width [pixels], default 800 */
+  int picture_size_panel;   /* output.picture.size_panel: a second panel coloured by size,
+                               default true when refinement.levels > 1 (false for the
+                               size field itself) */
   int picture_range_set;
   double picture_range[2]; /* output.picture.range: colour scale limits (default: auto) */
   int picture_box_set;
