@@ -6,7 +6,7 @@
  * reach 1). Mixed sizes (APR, paper 002 Sec. IV D): a particle of radius R_i scans
  * reach * ceil(R_i / R0) cells on each side of its own, so one grid serves every
  * level. A row of cells is one contiguous range of the sorted index, so the cost of
- * a wider scan is one range per row plus the particles in it (perf/bench_passes
+ * a wider scan is one range per row plus the particles in it (perf/bench_mixed
  * compares this with a grid made for the coarsest radius). Order inside a cell is by
  * particle index, so every sum is taken in the same order run after run
  * (bit-reproducible). */
@@ -64,9 +64,10 @@ static inline int rhod_cell_coord(real v, real o, real inv, int n) {
 }
 
 /* Cells scanned on each side for a support of radius R: reach * k with k = R/R0
- * rounded up. Sizes are dx_min 2^l, so R/R0 is a power of two up to rounding; the
- * 1e-4 keeps a rounding excess from adding a ring of cells (at worst it leaves out
- * the outer 1e-4 of a cell, where every kernel is 0 to 16 digits). In single
+ * rounded up. Sizes are dx_min e^l (e = 2, or sqrt 3 for the triangle pattern), so
+ * R/R0 is a power of e up to rounding; the 1e-4 keeps a rounding excess from adding a
+ * ring of cells (at worst it leaves out the outer 1e-4 of a cell, where every kernel is
+ * 0 to 16 digits). In single
  * resolution (every size = dx_min) k = 1: the same scan as before APR, bit for bit;
  * with levels > 1 a particle coarser than dx_min scans more cells of a finer grid,
  * which finds the same neighbours in another order (round-off differences). */
