@@ -54,6 +54,7 @@ static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch, 
   memset(b, 0, sizeof *b);
   sc->t_end = 1, sc->output_every = 1, sc->cfl = 0.5, sc->cfl_visc = 0.025;
   sc->dx = dx, sc->radius_ratio = 4, sc->kernel = RHOD_KERNEL_WENDLAND_C2;
+  sc->levels = 1; /* single resolution (0 made dx_min = 2 dx and cells twice too big) */
   sc->rho0 = 1000, sc->c0 = 10, sc->mu = 0;
   sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = 1;
   sc->free_surface = 1;

@@ -268,6 +268,12 @@ static int restate_initial(rhod_sim *s) {
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   memset(s, 0, sizeof *s);
   s->sc = sc;
+  if (sc->levels < 1 || sc->levels > RHOD_MAX_LEVELS) {
+    /* the loader never lets this through; a scene built by hand might */
+    snprintf(err, errlen, "%s: refinement.levels: %d is outside [1, %d]", sc->path, sc->levels,
+             RHOD_MAX_LEVELS);
+    return RHOD_ERR_SCENE;
+  }
   if (sc->has_domain) {
     for (int a = 0; a < 2; a++)
       s->lo[a] = sc->domain_min[a], s->hi[a] = sc->domain_max[a];

@@ -1096,6 +1096,19 @@ static void test_triangle_run(void) {
   run_close(&r);
 }
 
+/* A scene built by hand with no level count (0) is refused, not run with dx_min = 2 dx
+ * (perf/bench_common.h once did that: cells twice too large, 1.3x the cost). */
+static void test_levels_guard(void) {
+  rhod_scene *sc = unit_scene(0.01);
+  sc->levels = 0;
+  rhod_sim *s = calloc(1, sizeof *s);
+  char err[256] = "";
+  CU_ASSERT_EQUAL(rhod_sim_init(s, sc, err, sizeof err), RHOD_ERR_SCENE);
+  CU_ASSERT_PTR_NOT_NULL(strstr(err, "refinement.levels"));
+  free(s);
+  free(sc);
+}
+
 /* ------------------------------------------------------------------------------------ */
 /* 6. refinement.levels: 2 without any split is the single-resolution run                */
 
@@ -1215,6 +1228,7 @@ int main(void) {
       {"... also in groups of three (triangle)", test_coalesce_groups_triangle},
       {"coalescing in a run: merges back, never splits again", test_coalesce_run},
       {"a run with the triangle: level sizes, splits and merges", test_triangle_run},
+      {"a hand-made scene without levels is refused", test_levels_guard},
       {"snapshot free-surface flags, across levels and splits", test_free_surface_flags},
       {"levels 2 without splits = single resolution", test_equal_sizes_single_resolution},
       {"... also in a corner of the tank", test_equal_sizes_single_resolution_corner},

@@ -11,6 +11,7 @@ static inline rhod_scene *unit_scene(double dx) {
   rhod_scene *sc = calloc(1, sizeof *sc);
   sc->t_end = 1, sc->output_every = 1, sc->cfl = 0.5, sc->cfl_visc = 0.025;
   sc->dx = dx, sc->radius_ratio = 4, sc->kernel = RHOD_KERNEL_WENDLAND_C2;
+  sc->levels = 1;
   sc->rho0 = 1000, sc->c0 = 20, sc->mu = 0;
   sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = sc->free_surface = 1;
   sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
