@@ -204,7 +204,7 @@ static void disc(canvas *c, unsigned fh, double cx, double cy, double r,
 static void fmt_value(char *buf, size_t len, double x) { snprintf(buf, len, "%.4g", x); }
 
 /* Where a value falls on the colour scale [vmin, vmax]: linear, or logarithmic for the
- * particle size (levels are dx / 2^l: equal steps of colour per level). */
+ * particle size (levels are dx / e^l: equal steps of colour per level). */
 static double scale_at(rhod_field field, double f, double vmin, double vmax) {
   if (field == RHOD_FIELD_SIZE && vmin > 0 && vmax > vmin && f > 0)
     return log(f / vmin) / log(vmax / vmin);
