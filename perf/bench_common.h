@@ -94,6 +94,31 @@ static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch, 
   return rhod_sim_prepare(s, 1);
 }
 
+/* Candidates the gather loop visits and real pairs (j != i, r < R_i) over all
+ * particles, with the solver's own neighbour loop. */
+static inline void bench_count_pairs(const rhod_sim *s, double *visited, double *pairs) {
+  const rhod_particles *p = &s->p;
+  const rhod_cells *c = &s->cells;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *dx = p->dx;
+  const real ratio = (real)s->sc->radius_ratio;
+  const long n = (long)p->n;
+  long seen = 0, real_pairs = 0;
+  RHOD_KERNEL_LOOP_REDUCE2(+, seen, real_pairs)
+  for (long i = 0; i < n; i++) {
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi;
+      seen++;
+      if (j != i && rx * rx + ry * ry < R2)
+        real_pairs++;
+    }
+    RHOD_END_NEIGHBOURS
+  }
+  *visited = (double)seen, *pairs = (double)real_pairs;
+}
+
 static inline size_t bench_bytes(const rhod_particles *p) {
   size_t bytes = 0;
   for (int f = 0; f < p->nfields; f++)

@@ -14,30 +14,6 @@
 #include "kernel.h"
 #include "rhod/sph.h"
 
-/* Candidates visited and real pairs (j != i, r < R_i) over all particles. */
-static void count(const rhod_sim *s, double *visited, double *pairs) {
-  const rhod_particles *p = &s->p;
-  const rhod_cells *c = &s->cells;
-  const rhod_grid G = c->g;
-  const int32_t *CS = c->start, *CI = c->idx;
-  const real *x = p->x, *y = p->y, *dx = p->dx;
-  const real ratio = (real)s->sc->radius_ratio;
-  const long n = (long)p->n;
-  long seen = 0, real_pairs = 0;
-  RHOD_KERNEL_LOOP_REDUCE2(+, seen, real_pairs)
-  for (long i = 0; i < n; i++) {
-    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = x[j] - xi, ry = y[j] - yi;
-      seen++;
-      if (j != i && rx * rx + ry * ry < R2)
-        real_pairs++;
-    }
-    RHOD_END_NEIGHBOURS
-  }
-  *visited = (double)seen, *pairs = (double)real_pairs;
-}
-
 /* Times pass A and pass C (reps calls each); returns us per particle per call. */
 static void time_passes(rhod_sim *s, int reps, double *ua, double *uc) {
   rhod_particles *p = &s->p;
@@ -110,7 +86,7 @@ int main(int argc, char **argv) {
     }
     rhod_cells_build(&s.cells, p->x, p->y, p->n + p->ng);
     double visited, pairs, ua, uc;
-    count(&s, &visited, &pairs);
+    bench_count_pairs(&s, &visited, &pairs);
     rhod_sph_pass_a(&s.sph, p, &s.cells); /* warm-up */
     time_passes(&s, reps, &ua, &uc);
     /* the same neighbours, in another order: Gamma equal to round-off */
