@@ -33,6 +33,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   s->lam_hi = (real)sc->fs_lambda_high;
   s->gamma_th = (real)sc->shepard_threshold;
   s->theta_th = (real)sc->theta_threshold;
+  s->visc_cons = sc->viscosity == RHOD_VISCOSITY_CONSISTENT && sc->mu > 0;
   int st = RHOD_OK;
 #define F(var, k)                                                                                  \
   if (st == RHOD_OK)                                                                               \
@@ -57,6 +58,8 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   F(vel, 2);
   F(fs, 1);
   F(reg, 1);
+  if (s->visc_cons) /* a scene without it does not carry it */
+    F(lapB, 3);
 #undef F
   return st;
 }
@@ -97,8 +100,8 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *dx = p->dx;
   const real *P = s->P, *V = s->V;
   real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *gC = s->gC,
-       *uch = s->uch, *lam = s->lam;
-  const int kern = s->kernel;
+       *uch = s->uch, *lam = s->lam, *lapB = s->lapB;
+  const int kern = s->kernel, vcons = s->visc_cons;
   const real ratio = s->ratio;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
@@ -109,6 +112,11 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     const real iWdx = 1 / rhod_Wq(kern, dxi * iR); /* R^-2/W(dx_ij) of Eq. 29, dx_j = dx_i */
     real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
     real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0, um = 0;
+    /* moments of the consistent Laplacian (scheme.viscosity: consistent): T = sum F r
+     * n n n n, Q = sum F n n n, P3 = sum F r^2 n n n (fully symmetric; digits count the
+     * x and y indices) */
+    real T40 = 0, T31 = 0, T22 = 0, T13 = 0, T04 = 0;
+    real Q30 = 0, Q21 = 0, Q12 = 0, Q03 = 0, P30 = 0, P21 = 0, P12 = 0, P03 = 0;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
       if (r2 < R2 && j != i) {
@@ -135,6 +143,13 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
         cx += f * gwx, cy += f * gwy;
         const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
         um = un > um ? un : um;
+        if (vcons) {
+          const real exx = nx * nx, exy = nx * ny, eyy = ny * ny, a = F * r, b = F * r2;
+          T40 += a * exx * exx, T31 += a * exx * exy, T22 += a * exx * eyy;
+          T13 += a * exy * eyy, T04 += a * eyy * eyy;
+          Q30 += F * exx * nx, Q21 += F * exx * ny, Q12 += F * eyy * nx, Q03 += F * eyy * ny;
+          P30 += b * exx * nx, P21 += b * exx * ny, P12 += b * eyy * nx, P03 += b * eyy * ny;
+        }
       }
     }
     RHOD_END_NEIGHBOURS
@@ -162,6 +177,41 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     gu[4 * i + 1] = L1 * Gu0 + L3 * Gu1;
     gu[4 * i + 2] = L0 * Gu2 + L2 * Gu3;
     gu[4 * i + 3] = L1 * Gu2 + L3 * Gu3;
+    if (vcons) {
+      /* The consistent Laplacian (our choice for scheme.viscosity: consistent, in the
+       * manner of Fatehi & Manzari 2011; paper 002 names such higher-order operators
+       * after Eq. 10 without giving one): lap f_i = B^ : sum_j 2 F n n ((f_j - f_i)/r -
+       * n . grad f_i), grad f the renormalised gradient above. A Taylor expansion gives
+       * sum = T' : H with T'_abcd = T_abcd - Q_abm M_mcd, M = L^T P3 (the gradient's
+       * own error on a quadratic field), so B^ solves B^_ab T'_abcd = delta_cd and the
+       * operator is exact for quadratic fields on any cloud (tests/test_kernels.c). On
+       * a lattice T' = (delta delta + 2 sym) / 4 and B^ = I. */
+      const real Mx0 = L0 * P30 + L2 * P21, Mx1 = L0 * P21 + L2 * P12, Mx2 = L0 * P12 + L2 * P03;
+      const real My0 = L1 * P30 + L3 * P21, My1 = L1 * P21 + L3 * P12, My2 = L1 * P12 + L3 * P03;
+      /* T'_(ab)(cd), ab and cd in xx (0), xy (1), yy (2) */
+      const real t00 = T40 - (Q30 * Mx0 + Q21 * My0), t01 = T31 - (Q30 * Mx1 + Q21 * My1),
+                 t02 = T22 - (Q30 * Mx2 + Q21 * My2);
+      const real t10 = T31 - (Q21 * Mx0 + Q12 * My0), t11 = T22 - (Q21 * Mx1 + Q12 * My1),
+                 t12 = T13 - (Q21 * Mx2 + Q12 * My2);
+      const real t20 = T22 - (Q12 * Mx0 + Q03 * My0), t21 = T13 - (Q12 * Mx1 + Q03 * My1),
+                 t22 = T04 - (Q12 * Mx2 + Q03 * My2);
+      /* rows cd = xx, yy, xy; unknowns (B^xx, B^xy, B^yy); right side (1, 1, 0) */
+      const real a00 = t00, a01 = 2 * t10, a02 = t20;
+      const real a10 = t02, a11 = 2 * t12, a12 = t22;
+      const real a20 = t01, a21 = 2 * t11, a22 = t21;
+      const real det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) +
+                       a02 * (a10 * a21 - a11 * a20);
+      real bxx = 0, bxy = 0, byy = 0;
+      /* our choice: |det| below a tenth of the full support's 1/4 leaves B^ = 0, and
+       * pass C uses Eq. 10 for that particle */
+      if (fabs(det) > (real)0.025) {
+        const real id = 1 / det;
+        bxx = ((a11 * a22 - a12 * a21) - (a01 * a22 - a02 * a21)) * id;
+        bxy = ((a10 * a22 - a12 * a20) * -1 + (a00 * a22 - a02 * a20)) * id;
+        byy = ((a10 * a21 - a11 * a20) - (a00 * a21 - a01 * a20)) * id;
+      }
+      lapB[3 * i] = bxx, lapB[3 * i + 1] = bxy, lapB[3 * i + 2] = byy;
+    }
   }
 }
 
@@ -399,6 +449,8 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const real alpha_mu = s->mu != 0 ? 1 : 0, gx = s->gx, gy = s->gy;
   const real alpha_ad = damper ? s->alpha_ad : 0, gth = s->gamma_th, tth = s->theta_th;
   const real visc_k = 2 * (RHOD_DIM + 2) * s->mu; /* Eq. 10 */
+  const real *lapB = s->lapB, s_mu = s->mu;
+  const int vcons = s->visc_cons;
   /* Theta^u only without viscosity: the alpha_mu exclusion of Eq. 3 */
   const int theta_u = riemann && alpha_mu == 0;
   RHOD_KERNEL_LOOP
@@ -416,6 +468,12 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
      * parts. */
     const int inner = reg[i] == 0;
     const real renP = (inner && gam[i] >= gth) ? 1 : 0;
+    /* the consistent Laplacian where the pressure gradient is renormalised and B^ was
+     * solved (pass A); elsewhere Eq. 10 */
+    real bxx = 0, bxy = 0, byy = 0;
+    if (vcons && renP != 0)
+      bxx = lapB[3 * i], bxy = lapB[3 * i + 1], byy = lapB[3 * i + 2];
+    const int lapc = bxx + byy != 0;
     const real renT = (inner && gam[i] > tth) ? 1 : 0;
     const real kAD = alpha_ad * rho0 * c0 * (real)0.5 * Ri; /* Eq. 9, h_i = R_i/2 */
     real vRx = 0, vRy = 0, vCx = 0, vCy = 0, sfx = 0, sfy = 0;
@@ -461,7 +519,12 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
         }
         vRx += aR * fx, vRy += aR * fy;
         vCx += aC * fx, vCy += aC * fy;
-        if (visc_k != 0) {
+        if (lapc) {
+          /* consistent: 2 F (n.B^.n) ((u_j - u_i)/r - n.grad u_i), see pass A */
+          const real f = 2 * F * (bxx * nx * nx + 2 * bxy * nx * ny + byy * ny * ny);
+          vsx += f * ((ux[j] - uxi) * ir - (Gi[0] * nx + Gi[1] * ny));
+          vsy += f * ((uy[j] - uyi) * ir - (Gi[2] * nx + Gi[3] * ny));
+        } else if (visc_k != 0) {
           /* pi_ij of Eq. 10 */
           const real pij = ((ux[j] - uxi) * rx + (uy[j] - uyi) * ry) / r2;
           vsx += pij * fx, vsy += pij * fy;
@@ -487,7 +550,9 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
     real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * gy;
     /* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
     real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
-    if (visc_k != 0)
+    if (lapc) /* F^mu = mu lap u */
+      fx += s_mu * vsx, fy += s_mu * vsy;
+    else if (visc_k != 0)
       fx += alpha_mu * visc_k * vsx, fy += alpha_mu * visc_k * vsy;
     if (shifting) { /* Eq. 4 */
       dr += -rhoi * ddu + drdu;

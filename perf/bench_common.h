@@ -28,8 +28,9 @@ typedef struct {
 } bench_scene;
 
 /* Scheme switches from the command line: any of noshift, nodamper, nofs, noriemann,
- * norecon, visc (mu such that Re = 100 for the unit box). */
-static inline void bench_switches(rhod_scene *sc, int argc, char **argv, int first) {
+ * norecon, visc (mu such that Re = 100 for the unit box), visc_consistent (the same
+ * with scheme.viscosity: consistent). An unknown word is an error. */
+static inline int bench_switches(rhod_scene *sc, int argc, char **argv, int first) {
   for (int k = first; k < argc; k++) {
     if (!strcmp(argv[k], "noshift"))
       sc->shifting = 0;
@@ -43,7 +44,12 @@ static inline void bench_switches(rhod_scene *sc, int argc, char **argv, int fir
       sc->reconstruction = 0;
     else if (!strcmp(argv[k], "visc"))
       sc->mu = 10;
+    else if (!strcmp(argv[k], "visc_consistent"))
+      sc->mu = 10, sc->viscosity = RHOD_VISCOSITY_CONSISTENT;
+    else
+      return -1;
   }
+  return 0;
 }
 
 static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch, int argc,
@@ -69,7 +75,11 @@ static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch, 
   b->fb.shape.max[0] = L, b->fb.shape.max[1] = L;
   sc->fluid = &b->fb, sc->n_fluid = 1;
   sc->path = "bench";
-  bench_switches(sc, argc, argv, first);
+  if (bench_switches(sc, argc, argv, first) != 0) {
+    fprintf(stderr, "bench: unknown switch (noshift nodamper nofs noriemann norecon visc "
+                    "visc_consistent)\n");
+    return RHOD_ERR_USAGE;
+  }
   char err[512];
   if (rhod_sim_init(s, sc, err, sizeof err) != RHOD_OK) {
     fprintf(stderr, "bench: %s\n", err);

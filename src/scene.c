@@ -101,6 +101,7 @@ typedef struct {
   bool *free_surface;
   double *free_surface_lambda;
   double *shepard_threshold, *theta_threshold;
+  int *viscosity;
 } y_scheme;
 
 typedef struct {
@@ -236,6 +237,10 @@ static const cyaml_strval_t quantity_names[] = {
     {"pressure", RHOD_QTY_PRESSURE},
     {"dynamic_pressure", RHOD_QTY_DYNAMIC_PRESSURE},
 };
+static const cyaml_strval_t viscosity_names[] = {
+    {"monaghan", RHOD_VISCOSITY_MONAGHAN},
+    {"consistent", RHOD_VISCOSITY_CONSISTENT},
+};
 static const cyaml_strval_t pattern_names[] = {
     {"square", RHOD_PATTERN_SQUARE},
     {"triangle", RHOD_PATTERN_TRIANGLE},
@@ -280,6 +285,7 @@ static const cyaml_schema_field_t f_scheme[] = {
     VEC("free_surface_lambda", OPT, y_scheme, free_surface_lambda),
     NUM_OPT("shepard_threshold", y_scheme, shepard_threshold),
     NUM_OPT("theta_threshold", y_scheme, theta_threshold),
+    ENUM_OPT("viscosity", y_scheme, viscosity, viscosity_names),
     CYAML_FIELD_END,
 };
 
@@ -1345,6 +1351,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->fs_lambda_high = sc->free_surface_lambda ? sc->free_surface_lambda[1] : 0.75;
   s->shepard_threshold = opt(sc->shepard_threshold, 0.85);
   s->theta_threshold = opt(sc->theta_threshold, 0.95);
+  s->viscosity = sc->viscosity ? (rhod_viscosity)*sc->viscosity : RHOD_VISCOSITY_MONAGHAN;
   TRY(check_positive(c, "scheme.shifting_a", s->shift_a));
   if (!(s->shift_b >= 0))
     return fail(c, "scheme.shifting_b", "must be >= 0, got %g", s->shift_b);
@@ -1697,6 +1704,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_vec(&t, m, "free_surface_lambda", lambda);
   tb_num(&t, m, "shepard_threshold", s->shepard_threshold);
   tb_num(&t, m, "theta_threshold", s->theta_threshold);
+  tb_word(&t, m, "viscosity",
+          strval_name(viscosity_names, CYAML_ARRAY_LEN(viscosity_names), (int)s->viscosity));
   m = tb_coll(&t, root, "domain", RY_MAP, 0);
   if (s->has_domain) {
     tb_vec(&t, m, "min", s->domain_min);

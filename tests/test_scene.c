@@ -318,6 +318,7 @@ static const struct {
     {"refine_coalesce_static.yaml", 13, "refinement.coalesce", "needs dynamic refinement"},
     {"refine_pattern_unknown.yaml", 12, "refinement.pattern", "hexagon"},
     {"refine_triangle_regions.yaml", 14, "refinement.regions", "need refinement.pattern: square"},
+    {"viscosity_unknown.yaml", 12, "scheme.viscosity", "invalid value 'morris'"},
     {"refine_levels_fraction.yaml", 11, "refinement.levels", "whole number"},
     {"refine_levels_zero.yaml", 11, "refinement.levels", "whole number"},
     {"refine_region_level.yaml", 14, "refinement.regions.0.level", "whole number"},

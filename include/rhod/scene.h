@@ -101,6 +101,12 @@ typedef enum {
 /* Most particle sizes a scene may use: dx, dx/e, ..., dx/e^(RHOD_MAX_LEVELS-1). */
 #define RHOD_MAX_LEVELS 8
 
+/* scheme.viscosity: how F^mu approximates mu lap u. Monaghan: paper 002 Eq. 10 (the
+ * default). Consistent: exact for quadratic velocity fields on any particle cloud, in
+ * the bulk (our choice, the higher-order operator paper 002 points to after Eq. 10;
+ * docs/choices.md "Consistent viscous operator"). */
+typedef enum { RHOD_VISCOSITY_MONAGHAN = 0, RHOD_VISCOSITY_CONSISTENT } rhod_viscosity;
+
 /* refinement.pattern: how a particle splits (paper 002 Sec. V A and Appendix, Fig. 32).
  * Square: 1 -> 4, level size ratio e = dx_l / dx_(l+1) = 2 (the paper's pattern);
  * triangle: 1 -> 3, e = sqrt 3 (the Appendix's choice for R/dx = 3). The children have
@@ -156,6 +162,7 @@ typedef struct {
   double fs_lambda_low, fs_lambda_high; /* scheme.free_surface_lambda: [0.2, 0.75] */
   double shepard_threshold;             /* scheme.shepard_threshold: Gamma_th = 0.85 (Eq. 6) */
   double theta_threshold;               /* scheme.theta_threshold: 0.95 (Eq. 24) */
+  rhod_viscosity viscosity;             /* scheme.viscosity: the Laplacian of F^mu */
   /* domain (default: the bounding box of walls and fluid): */
   int has_domain;
   double domain_min[2], domain_max[2];

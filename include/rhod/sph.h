@@ -15,6 +15,7 @@ typedef struct {
   real rho0, c0, mu, gx, gy;
   real cfl, cfl_visc;
   int riemann, recon, shifting, damper, fsdetect;
+  int visc_cons; /* scheme.viscosity: consistent (and mu > 0) */
   real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
   /* per-particle fields (scratch, rebuilt each stage) */
   real *P, *V;
@@ -23,6 +24,8 @@ typedef struct {
   real *gP, *gu;          /* renormalised gradients (Eq. 14) of P (2) and u (4: dux/dx,
                              dux/dy, duy/dx, duy/dy) */
   real *D;                /* velocity divergence (Eq. 5) */
+  real *lapB;             /* consistent Laplacian's correction B^ (xx, xy, yy), 3; only
+                             with visc_cons; B^ = 0 where it cannot be solved */
   real *gC;               /* concentration gradient (Eq. 29), 2 */
   real *uch;              /* U_char (after Eq. 27) */
   real *lam;              /* smallest eigenvalue of sym(L^-1) */
