@@ -429,28 +429,105 @@ static void mark_store(rhod_scene *sc, rhod_particles *p, rhod_sph *s, rhod_cell
 /* ------------------------------------------------------------------------------------ */
 /* 3. rhod_apr_split on a hand-made store: where the children go and what they carry     */
 
+/* The store of the split tests: a jittered nx x ny lattice (room for the fluid only, so
+ * the split must grow it) with the linear pressure ga x + gb y + gc through the EOS (its
+ * renormalised gradient is exact) and a velocity u0 + du i that tells each particle's
+ * children apart. Criterion 5 marks every particle, so every one gets its orientation
+ * searched. */
+typedef struct {
+  double ga, gb, gc, u0x, dux, u0y, duy;
+} split_fields;
+static long split_store(rhod_scene *sc, rhod_particles *p, int nx, int ny, double dx,
+                        unsigned long seed, const split_fields *f) {
+  const double c0 = 20, rho0 = 1000;
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(p, (size_t)(nx * ny) + 8), RHOD_OK);
+  add_block(p, 0, 0, nx, ny, dx, 0.5, &seed);
+  const long n0 = (long)p->n;
+  for (long i = 0; i < n0; i++) {
+    p->rho[i] = (real)(rho0 + (f->ga * p->x[i] + f->gb * p->y[i] + f->gc) / (c0 * c0));
+    p->m[i] = (real)(p->rho[i] * dx * dx);
+    p->ux[i] = (real)(f->u0x + f->dux * i), p->uy[i] = (real)(f->u0y + f->duy * i);
+  }
+  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
+  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  return n0;
+}
+
+/* The state before the split (x, y, ux, uy, rho, m per particle) and the direction e_i
+ * to each particle's nearest neighbour, by brute force. */
+static void split_before(const rhod_particles *p, long n0, real *before, real *e) {
+  for (long i = 0; i < n0; i++) {
+    const real v[6] = {p->x[i], p->y[i], p->ux[i], p->uy[i], p->rho[i], p->m[i]};
+    memcpy(before + 6 * i, v, sizeof v);
+    double best = HUGE_VAL;
+    for (long j = 0; j < n0; j++) {
+      const double rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i], r = hypot(rx, ry);
+      if (j != i && r < best)
+        best = r, e[2 * i] = (real)(rx / r), e[2 * i + 1] = (real)(ry / r);
+    }
+  }
+}
+
+/* The children of the parent whose state was B: the particles with its velocity
+ * (distinct per parent); up to nmax indices in ch, returns how many there are. */
+static long split_children(const rhod_particles *p, const real *B, long *ch, long nmax) {
+  long nc = 0;
+  for (long j = 0; j < (long)p->n; j++)
+    if (p->ux[j] == B[2] && p->uy[j] == B[3]) {
+      if (nc < nmax)
+        ch[nc] = j;
+      nc++;
+    }
+  return nc;
+}
+
+/* The orientation score (Sec. V A, docs/choices.md) of nc children at offsets (ox, oy)
+ * from parent i and of a reference pattern (rx, ry): the smaller of the sibling spacing
+ * and, over the particles within 2 dx before the split, twice the distance by which
+ * every child stays on the parent's side of the mid-point (equal sizes: w_i = 1/2). */
+static void split_scores(const real *before, long n0, long i, double dx, int nc, const double *ox,
+                         const double *oy, const double *px, const double *py, double *s_got,
+                         double *s_ref) {
+  *s_got = *s_ref = HUGE_VAL;
+  for (int q = 0; q < nc; q++)
+    for (int t = q + 1; t < nc; t++) {
+      *s_got = fmin(*s_got, hypot(ox[t] - ox[q], oy[t] - oy[q]));
+      *s_ref = fmin(*s_ref, hypot(px[t] - px[q], py[t] - py[q]));
+    }
+  const real *B = before + 6 * i;
+  for (long j = 0; j < n0; j++) {
+    const real *Bj = before + 6 * j;
+    const double rx = Bj[0] - B[0], ry = Bj[1] - B[1], r = hypot(rx, ry);
+    if (j == i || r >= 2 * dx)
+      continue;
+    for (int q = 0; q < nc; q++) {
+      *s_got = fmin(*s_got, 2 * (0.5 * r - (ox[q] * rx + oy[q] * ry) / r));
+      *s_ref = fmin(*s_ref, 2 * (0.5 * r - (px[q] * rx + py[q] * ry) / r));
+    }
+  }
+}
+
+/* 1 when the children stand on the reference pattern's corners, in any order. */
+static int split_same_corners(int nc, const double *ox, const double *oy, const double *px,
+                              const double *py, double tol) {
+  int all = 1;
+  for (int q = 0; q < nc; q++) {
+    int found = 0;
+    for (int t = 0; t < nc; t++)
+      found |= hypot(ox[q] - px[t], oy[q] - py[t]) < tol;
+    all &= found;
+  }
+  return all;
+}
+
 static void test_split_geometry(void) {
   const double dx = 0.01, c0 = 20, rho0 = 1000;
   rhod_scene *sc = unit_scene(dx);
   rhod_particles p;
   const int nx = 20, ny = 20;
-  /* room for the fluid only: the split must grow the store */
-  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, (size_t)(nx * ny) + 8), RHOD_OK);
-  unsigned long seed = 3;
-  add_block(&p, 0, 0, nx, ny, dx, 0.5, &seed);
-  const long n0 = (long)p.n;
-  /* a linear pressure field (its renormalised gradient is exact) and a velocity that
-   * differs from particle to particle */
-  const double ga = 2500, gb = -1250, gc = 400;
-  for (long i = 0; i < n0; i++) {
-    p.rho[i] = (real)(rho0 + (ga * p.x[i] + gb * p.y[i] + gc) / (c0 * c0));
-    p.m[i] = (real)(p.rho[i] * dx * dx);
-    p.ux[i] = (real)(0.1 + 0.001 * i);
-    p.uy[i] = (real)(-0.05 - 0.002 * i);
-  }
-  /* criterion 5 marks every particle, so every one gets its orientation searched */
-  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
-  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  const split_fields fl = {2500, -1250, 400, 0.1, 0.001, -0.05, -0.002};
+  const double ga = fl.ga, gb = fl.gb, gc = fl.gc;
+  const long n0 = split_store(sc, &p, nx, ny, dx, 3, &fl);
   const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
   rhod_sph s;
   rhod_cells c;
@@ -463,19 +540,9 @@ static void test_split_geometry(void) {
     want[i] = i % 7 == 3, k += want[i];
   memcpy(a.mark, want, (size_t)n0);
   rhod_to_device(a.mark, (size_t)n0);
-  /* the state before, and each particle's nearest neighbour by brute force */
   real *before = malloc(6 * (size_t)n0 * sizeof(real));
   real *e = malloc(2 * (size_t)n0 * sizeof(real));
-  for (long i = 0; i < n0; i++) {
-    const real v[6] = {p.x[i], p.y[i], p.ux[i], p.uy[i], p.rho[i], p.m[i]};
-    memcpy(before + 6 * i, v, sizeof v);
-    double best = HUGE_VAL;
-    for (long j = 0; j < n0; j++) {
-      const double rx = p.x[j] - p.x[i], ry = p.y[j] - p.y[i], r = hypot(rx, ry);
-      if (j != i && r < best)
-        best = r, e[2 * i] = (real)(rx / r), e[2 * i + 1] = (real)(ry / r);
-    }
-  }
+  split_before(&p, n0, before, e);
   const uint64_t id0 = p.next_id;
   const long split = rhod_apr_split(&a, &s, &p, &nowalls);
   rhod_particles_to_host(&p);
@@ -498,15 +565,8 @@ static void test_split_geometry(void) {
                         p.id[i] != (uint64_t)i;
       continue;
     }
-    /* the children: the particles with i's velocity (distinct per parent) */
-    long ch[4], nc = 0;
-    for (long j = 0; j < (long)p.n; j++)
-      if (p.ux[j] == B[2] && p.uy[j] == B[3]) {
-        if (nc < 4)
-          ch[nc] = j;
-        nc++;
-      }
-    if (nc != 4) {
+    long ch[4];
+    if (split_children(&p, B, ch, 4) != 4) {
       wrong_count++;
       continue;
     }
@@ -544,38 +604,16 @@ static void test_split_geometry(void) {
       erect = fmax(erect, fabs(r[0] * r[0] + r[1] * r[1] - r[2] * r[2]) / (h * h));
     }
     /* orientation and aspect (Sec. V A, docs/choices.md): the pattern must score at
-     * least as well as the paper's square aligned with the nearest neighbour; the
-     * score is the smaller of the sibling spacing and, over the particles within
-     * 2 dx before the split, twice the distance by which every child stays on the
-     * parent's side of the mid-point (equal sizes: w_i = 1/2) */
+     * least as well as the paper's square aligned with the nearest neighbour */
     double sq_x[4], sq_y[4];
     for (int q = 0; q < 4; q++) {
       const double sa = (q & 1) ? dx / 4 : -dx / 4, sb = (q & 2) ? dx / 4 : -dx / 4;
       sq_x[q] = sa * e[2 * i] - sb * e[2 * i + 1], sq_y[q] = sa * e[2 * i + 1] + sb * e[2 * i];
     }
-    double s_got = HUGE_VAL, s_sq = dx / 2;
-    for (int q = 0; q < 4; q++)
-      for (int t = q + 1; t < 4; t++)
-        s_got = fmin(s_got, hypot(ox[t] - ox[q], oy[t] - oy[q]));
-    for (long j = 0; j < n0; j++) {
-      const real *Bj = before + 6 * j;
-      const double rx = Bj[0] - B[0], ry = Bj[1] - B[1], r = hypot(rx, ry);
-      if (j == i || r >= 2 * dx)
-        continue;
-      for (int q = 0; q < 4; q++) {
-        s_got = fmin(s_got, 2 * (0.5 * r - (ox[q] * rx + oy[q] * ry) / r));
-        s_sq = fmin(s_sq, 2 * (0.5 * r - (sq_x[q] * rx + sq_y[q] * ry) / r));
-      }
-    }
-    int aligned = 1;
-    for (int q = 0; q < 4; q++) { /* the children are the square's corners, in any order */
-      int found = 0;
-      for (int t = 0; t < 4; t++)
-        found |= hypot(ox[q] - sq_x[t], oy[q] - sq_y[t]) < TOL(1e-12) * dx;
-      aligned &= found;
-    }
+    double s_got, s_sq;
+    split_scores(before, n0, i, dx, 4, ox, oy, sq_x, sq_y, &s_got, &s_sq);
     worse += s_got < s_sq - TOL(1e-12) * dx;
-    turned += !aligned;
+    turned += !split_same_corners(4, ox, oy, sq_x, sq_y, TOL(1e-12) * dx);
   }
   CU_ASSERT(k > 50);
   CU_ASSERT_EQUAL(wrong_unmarked, 0);
@@ -608,18 +646,9 @@ static void test_split_triangle(void) {
   sc->pattern = RHOD_PATTERN_TRIANGLE;
   rhod_particles p;
   const int nx = 20, ny = 20;
-  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, (size_t)(nx * ny) + 8), RHOD_OK);
-  unsigned long seed = 11;
-  add_block(&p, 0, 0, nx, ny, dx, 0.5, &seed);
-  const long n0 = (long)p.n;
-  const double ga = -1500, gb = 3000, gc = 200;
-  for (long i = 0; i < n0; i++) {
-    p.rho[i] = (real)(rho0 + (ga * p.x[i] + gb * p.y[i] + gc) / (c0 * c0));
-    p.m[i] = (real)(p.rho[i] * dx * dx);
-    p.ux[i] = (real)(0.2 + 0.001 * i), p.uy[i] = (real)(0.05 - 0.003 * i);
-  }
-  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
-  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  const split_fields fl = {-1500, 3000, 200, 0.2, 0.001, 0.05, -0.003};
+  const double ga = fl.ga, gb = fl.gb, gc = fl.gc;
+  const long n0 = split_store(sc, &p, nx, ny, dx, 11, &fl);
   const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
   rhod_sph s;
   rhod_cells c;
@@ -630,17 +659,9 @@ static void test_split_triangle(void) {
   real *before = malloc(6 * (size_t)n0 * sizeof(real));
   real *e = malloc(2 * (size_t)n0 * sizeof(real));
   long k = 0;
-  for (long i = 0; i < n0; i++) {
+  for (long i = 0; i < n0; i++)
     want[i] = i % 5 == 2, k += want[i];
-    const real v[6] = {p.x[i], p.y[i], p.ux[i], p.uy[i], p.rho[i], p.m[i]};
-    memcpy(before + 6 * i, v, sizeof v);
-    double best = HUGE_VAL;
-    for (long j = 0; j < n0; j++) {
-      const double rx = p.x[j] - p.x[i], ry = p.y[j] - p.y[i], r = hypot(rx, ry);
-      if (j != i && r < best)
-        best = r, e[2 * i] = (real)(rx / r), e[2 * i + 1] = (real)(ry / r);
-    }
-  }
+  split_before(&p, n0, before, e);
   memcpy(a.mark, want, (size_t)n0);
   rhod_to_device(a.mark, (size_t)n0);
   const long split = rhod_apr_split(&a, &s, &p, &nowalls);
@@ -654,14 +675,8 @@ static void test_split_triangle(void) {
     if (!want[i])
       continue;
     const real *B = before + 6 * i;
-    long ch[3], nc = 0;
-    for (long j = 0; j < (long)p.n; j++)
-      if (p.ux[j] == B[2] && p.uy[j] == B[3]) {
-        if (nc < 3)
-          ch[nc] = j;
-        nc++;
-      }
-    if (nc != 3) {
+    long ch[3];
+    if (split_children(&p, B, ch, 3) != 3) {
       wrong_count++;
       continue;
     }
@@ -686,26 +701,10 @@ static void test_split_triangle(void) {
       tx[q] = rt * (cq * e[2 * i] - sq * e[2 * i + 1]);
       ty[q] = rt * (cq * e[2 * i + 1] + sq * e[2 * i]);
     }
-    double s_got = side, s_tri = side;
-    for (long j = 0; j < n0; j++) {
-      const real *Bj = before + 6 * j;
-      const double rx = Bj[0] - B[0], ry = Bj[1] - B[1], r = hypot(rx, ry);
-      if (j == i || r >= 2 * dx)
-        continue;
-      for (int q = 0; q < 3; q++) {
-        s_got = fmin(s_got, 2 * (0.5 * r - (ox[q] * rx + oy[q] * ry) / r));
-        s_tri = fmin(s_tri, 2 * (0.5 * r - (tx[q] * rx + ty[q] * ry) / r));
-      }
-    }
-    int aligned = 1;
-    for (int q = 0; q < 3; q++) {
-      int found = 0;
-      for (int t = 0; t < 3; t++)
-        found |= hypot(ox[q] - tx[t], oy[q] - ty[t]) < TOL(1e-12) * dx;
-      aligned &= found;
-    }
+    double s_got, s_tri;
+    split_scores(before, n0, i, dx, 3, ox, oy, tx, ty, &s_got, &s_tri);
     worse += s_got < s_tri - TOL(1e-12) * dx;
-    turned += !aligned;
+    turned += !split_same_corners(3, ox, oy, tx, ty, TOL(1e-12) * dx);
   }
   printf("\ntriangle: %ld split, %ld turned from the nearest neighbour\n", k, turned);
   CU_ASSERT(k > 50);
