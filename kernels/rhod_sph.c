@@ -207,7 +207,7 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       if (fabs(det) > (real)0.025) {
         const real id = 1 / det;
         bxx = ((a11 * a22 - a12 * a21) - (a01 * a22 - a02 * a21)) * id;
-        bxy = ((a10 * a22 - a12 * a20) * -1 + (a00 * a22 - a02 * a20)) * id;
+        bxy = ((a00 * a22 - a02 * a20) - (a10 * a22 - a12 * a20)) * id;
         byy = ((a10 * a21 - a11 * a20) - (a00 * a21 - a01 * a20)) * id;
       }
       lapB[3 * i] = bxx, lapB[3 * i + 1] = bxy, lapB[3 * i + 2] = byy;

@@ -429,30 +429,6 @@ static void mark_store(rhod_scene *sc, rhod_particles *p, rhod_sph *s, rhod_cell
 /* ------------------------------------------------------------------------------------ */
 /* 3. rhod_apr_split on a hand-made store: where the children go and what they carry     */
 
-/* The store of the split tests: a jittered nx x ny lattice (room for the fluid only, so
- * the split must grow it) with the linear pressure ga x + gb y + gc through the EOS (its
- * renormalised gradient is exact) and a velocity u0 + du i that tells each particle's
- * children apart. Criterion 5 marks every particle, so every one gets its orientation
- * searched. */
-typedef struct {
-  double ga, gb, gc, u0x, dux, u0y, duy;
-} split_fields;
-static long split_store(rhod_scene *sc, rhod_particles *p, int nx, int ny, double dx,
-                        unsigned long seed, const split_fields *f) {
-  const double c0 = 20, rho0 = 1000;
-  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(p, (size_t)(nx * ny) + 8), RHOD_OK);
-  add_block(p, 0, 0, nx, ny, dx, 0.5, &seed);
-  const long n0 = (long)p->n;
-  for (long i = 0; i < n0; i++) {
-    p->rho[i] = (real)(rho0 + (f->ga * p->x[i] + f->gb * p->y[i] + f->gc) / (c0 * c0));
-    p->m[i] = (real)(p->rho[i] * dx * dx);
-    p->ux[i] = (real)(f->u0x + f->dux * i), p->uy[i] = (real)(f->u0y + f->duy * i);
-  }
-  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
-  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
-  return n0;
-}
-
 /* The state before the split (x, y, ux, uy, rho, m per particle) and the direction e_i
  * to each particle's nearest neighbour, by brute force. */
 static void split_before(const rhod_particles *p, long n0, real *before, real *e) {
@@ -466,6 +442,69 @@ static void split_before(const rhod_particles *p, long n0, real *before, real *e
         best = r, e[2 * i] = (real)(rx / r), e[2 * i + 1] = (real)(ry / r);
     }
   }
+}
+
+/* The store of the split tests: a jittered 20 x 20 lattice (room for the fluid only, so
+ * the split must grow it) with the linear pressure ga x + gb y + gc through the EOS (its
+ * renormalised gradient is exact) and a velocity u0 + du i that tells each particle's
+ * children apart. Criterion 5 marks every particle, so every one gets its orientation
+ * searched; then every particle with i % every == phase is split (edges included),
+ * whatever the criteria said. */
+typedef struct {
+  double ga, gb, gc, u0x, dux, u0y, duy;
+} split_fields;
+typedef struct {
+  rhod_scene *sc;
+  rhod_particles p;
+  rhod_sph s;
+  rhod_cells c;
+  rhod_apr a;
+  long n0, k, split; /* particles before, marked, split */
+  uint64_t id0;      /* next_id before the split */
+  uint8_t *want;     /* the marks */
+  real *before, *e;  /* split_before's state and nearest-neighbour directions */
+} split_case;
+static void split_case_run(split_case *t, rhod_pattern pattern, unsigned long seed,
+                           const split_fields *f, int every, int phase) {
+  const double dx = 0.01, c0 = 20, rho0 = 1000;
+  const int nx = 20, ny = 20;
+  t->sc = unit_scene(dx);
+  t->sc->pattern = pattern;
+  rhod_particles *p = &t->p;
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(p, (size_t)(nx * ny) + 8), RHOD_OK);
+  add_block(p, 0, 0, nx, ny, dx, 0.5, &seed);
+  const long n0 = t->n0 = (long)p->n;
+  for (long i = 0; i < n0; i++) {
+    p->rho[i] = (real)(rho0 + (f->ga * p->x[i] + f->gb * p->y[i] + f->gc) / (c0 * c0));
+    p->m[i] = (real)(p->rho[i] * dx * dx);
+    p->ux[i] = (real)(f->u0x + f->dux * i), p->uy[i] = (real)(f->u0y + f->duy * i);
+  }
+  rhod_scene *sc = t->sc;
+  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
+  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
+  mark_store(sc, p, &t->s, &t->c, &t->a, lo, hi, dx, dx / rhod_pattern_ratio(pattern));
+  t->want = calloc((size_t)n0, 1);
+  t->k = 0;
+  for (long i = 0; i < n0; i++)
+    t->want[i] = i % every == phase, t->k += t->want[i];
+  memcpy(t->a.mark, t->want, (size_t)n0);
+  rhod_to_device(t->a.mark, (size_t)n0);
+  t->before = malloc(6 * (size_t)n0 * sizeof(real));
+  t->e = malloc(2 * (size_t)n0 * sizeof(real));
+  split_before(p, n0, t->before, t->e);
+  t->id0 = p->next_id;
+  t->split = rhod_apr_split(&t->a, &t->s, p, &nowalls);
+  rhod_particles_to_host(p);
+}
+static void split_case_free(split_case *t) {
+  free(t->want);
+  free(t->before);
+  free(t->e);
+  rhod_apr_free(&t->a);
+  rhod_cells_free(&t->c);
+  rhod_particles_free(&t->p);
+  free(t->sc);
 }
 
 /* The children of the parent whose state was B: the particles with its velocity
@@ -522,37 +561,22 @@ static int split_same_corners(int nc, const double *ox, const double *oy, const 
 
 static void test_split_geometry(void) {
   const double dx = 0.01, c0 = 20, rho0 = 1000;
-  rhod_scene *sc = unit_scene(dx);
-  rhod_particles p;
-  const int nx = 20, ny = 20;
   const split_fields fl = {2500, -1250, 400, 0.1, 0.001, -0.05, -0.002};
   const double ga = fl.ga, gb = fl.gb, gc = fl.gc;
-  const long n0 = split_store(sc, &p, nx, ny, dx, 3, &fl);
-  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
-  rhod_sph s;
-  rhod_cells c;
-  rhod_apr a;
-  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2);
-  /* split every 7th particle (edges included), whatever the criteria said */
-  uint8_t *want = calloc((size_t)n0, 1);
-  long k = 0;
-  for (long i = 0; i < n0; i++)
-    want[i] = i % 7 == 3, k += want[i];
-  memcpy(a.mark, want, (size_t)n0);
-  rhod_to_device(a.mark, (size_t)n0);
-  real *before = malloc(6 * (size_t)n0 * sizeof(real));
-  real *e = malloc(2 * (size_t)n0 * sizeof(real));
-  split_before(&p, n0, before, e);
-  const uint64_t id0 = p.next_id;
-  const long split = rhod_apr_split(&a, &s, &p, &nowalls);
-  rhod_particles_to_host(&p);
-  CU_ASSERT_EQUAL(split, k);
-  CU_ASSERT_EQUAL(a.split_last, k);
-  CU_ASSERT_EQUAL_FATAL((long)p.n, n0 + 3 * k);
-  CU_ASSERT_EQUAL(p.next_id, id0 + 3 * (uint64_t)k);
+  split_case t;
+  split_case_run(&t, RHOD_PATTERN_SQUARE, 3, &fl, 7, 3);
+  rhod_particles *p = &t.p;
+  const long n0 = t.n0, k = t.k;
+  const uint8_t *want = t.want;
+  const real *before = t.before, *e = t.e;
+  const uint64_t id0 = t.id0;
+  CU_ASSERT_EQUAL(t.split, k);
+  CU_ASSERT_EQUAL(t.a.split_last, k);
+  CU_ASSERT_EQUAL_FATAL((long)p->n, n0 + 3 * k);
+  CU_ASSERT_EQUAL(p->next_id, id0 + 3 * (uint64_t)k);
   /* ids: unique, the new ones from next_id on */
-  rhod_snapshot_view v = {.n = p.n, .id = p.id};
-  CU_ASSERT(ids_unique(&v, p.next_id));
+  rhod_snapshot_view v = {.n = p->n, .id = p->id};
+  CU_ASSERT(ids_unique(&v, p->next_id));
   long wrong_unmarked = 0, wrong_count = 0, wrong_id = 0, wrong_state = 0, wrong_pressure = 0;
   double erect = 0, ecentre = 0;
   long worse = 0, turned = 0;
@@ -560,13 +584,13 @@ static void test_split_geometry(void) {
   for (long i = 0; i < n0; i++) {
     const real *B = before + 6 * i;
     if (!want[i]) {
-      wrong_unmarked += p.x[i] != B[0] || p.y[i] != B[1] || p.ux[i] != B[2] || p.uy[i] != B[3] ||
-                        p.rho[i] != B[4] || p.m[i] != B[5] || p.dx[i] != (real)dx ||
-                        p.id[i] != (uint64_t)i;
+      wrong_unmarked += p->x[i] != B[0] || p->y[i] != B[1] || p->ux[i] != B[2] ||
+                        p->uy[i] != B[3] || p->rho[i] != B[4] || p->m[i] != B[5] ||
+                        p->dx[i] != (real)dx || p->id[i] != (uint64_t)i;
       continue;
     }
     long ch[4];
-    if (split_children(&p, B, ch, 4) != 4) {
+    if (split_children(p, B, ch, 4) != 4) {
       wrong_count++;
       continue;
     }
@@ -574,14 +598,14 @@ static void test_split_geometry(void) {
     double cx = 0, cy = 0, ox[4], oy[4];
     for (int q = 0; q < 4; q++) {
       const long j = ch[q];
-      keeps += j == i && p.id[j] == (uint64_t)i;
-      wrong_id += j != i && p.id[j] < id0;
-      wrong_state += p.m[j] != (real)0.25 * B[5] || p.dx[j] != (real)h;
-      ox[q] = p.x[j] - B[0], oy[q] = p.y[j] - B[1];
+      keeps += j == i && p->id[j] == (uint64_t)i;
+      wrong_id += j != i && p->id[j] < id0;
+      wrong_state += p->m[j] != (real)0.25 * B[5] || p->dx[j] != (real)h;
+      ox[q] = p->x[j] - B[0], oy[q] = p->y[j] - B[1];
       cx += ox[q] / 4, cy += oy[q] / 4;
       /* P_c = P_i + grad P . (x_c - x_i): exactly the linear field at x_c */
-      const double Pc = ((double)p.rho[j] - rho0) * c0 * c0;
-      wrong_pressure += fabs(Pc - (ga * p.x[j] + gb * p.y[j] + gc)) > TOL(1e-5) * 1e4;
+      const double Pc = ((double)p->rho[j] - rho0) * c0 * c0;
+      wrong_pressure += fabs(Pc - (ga * p->x[j] + gb * p->y[j] + gc)) > TOL(1e-5) * 1e4;
     }
     wrong_id += keeps != 1;
     ecentre = fmax(ecentre, hypot(cx, cy) / dx);
@@ -625,13 +649,7 @@ static void test_split_geometry(void) {
   CU_ASSERT(ecentre < TOL(1e-12));
   CU_ASSERT_EQUAL(worse, 0);
   CU_ASSERT(turned > 0); /* on a jittered lattice the search does turn some squares */
-  free(want);
-  free(before);
-  free(e);
-  rhod_apr_free(&a);
-  rhod_cells_free(&c);
-  rhod_particles_free(&p);
-  free(sc);
+  split_case_free(&t);
 }
 
 /* The 1 -> 3 triangle of the Appendix (Fig. 32), on the jittered lattice of
@@ -642,32 +660,17 @@ static void test_split_geometry(void) {
  * nearest neighbour (the score of test_split_geometry), and the search turns some. */
 static void test_split_triangle(void) {
   const double dx = 0.01, c0 = 20, rho0 = 1000, side = dx / sqrt(3.0), rt = dx / 3;
-  rhod_scene *sc = unit_scene(dx);
-  sc->pattern = RHOD_PATTERN_TRIANGLE;
-  rhod_particles p;
-  const int nx = 20, ny = 20;
   const split_fields fl = {-1500, 3000, 200, 0.2, 0.001, 0.05, -0.003};
   const double ga = fl.ga, gb = fl.gb, gc = fl.gc;
-  const long n0 = split_store(sc, &p, nx, ny, dx, 11, &fl);
-  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
-  rhod_sph s;
-  rhod_cells c;
-  rhod_apr a;
-  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, side);
-  CU_ASSERT_EQUAL(a.nsplit, 3);
-  uint8_t *want = calloc((size_t)n0, 1);
-  real *before = malloc(6 * (size_t)n0 * sizeof(real));
-  real *e = malloc(2 * (size_t)n0 * sizeof(real));
-  long k = 0;
-  for (long i = 0; i < n0; i++)
-    want[i] = i % 5 == 2, k += want[i];
-  split_before(&p, n0, before, e);
-  memcpy(a.mark, want, (size_t)n0);
-  rhod_to_device(a.mark, (size_t)n0);
-  const long split = rhod_apr_split(&a, &s, &p, &nowalls);
-  rhod_particles_to_host(&p);
-  CU_ASSERT_EQUAL(split, k);
-  CU_ASSERT_EQUAL_FATAL((long)p.n, n0 + 2 * k);
+  split_case t;
+  split_case_run(&t, RHOD_PATTERN_TRIANGLE, 11, &fl, 5, 2);
+  rhod_particles *p = &t.p;
+  const long n0 = t.n0, k = t.k;
+  const uint8_t *want = t.want;
+  const real *before = t.before, *e = t.e;
+  CU_ASSERT_EQUAL(t.a.nsplit, 3);
+  CU_ASSERT_EQUAL(t.split, k);
+  CU_ASSERT_EQUAL_FATAL((long)p->n, n0 + 2 * k);
   long wrong_count = 0, wrong_state = 0, wrong_pressure = 0, worse = 0, turned = 0;
   double eside = 0, ecentre = 0;
   const real child = (real)dx * (real)(1 / sqrt(3.0)), third = (real)1 / (real)3;
@@ -676,18 +679,18 @@ static void test_split_triangle(void) {
       continue;
     const real *B = before + 6 * i;
     long ch[3];
-    if (split_children(&p, B, ch, 3) != 3) {
+    if (split_children(p, B, ch, 3) != 3) {
       wrong_count++;
       continue;
     }
     double ox[3], oy[3], cx = 0, cy = 0;
     for (int q = 0; q < 3; q++) {
       const long j = ch[q];
-      wrong_state += p.m[j] != third * B[5] || p.dx[j] != child;
-      ox[q] = p.x[j] - B[0], oy[q] = p.y[j] - B[1];
+      wrong_state += p->m[j] != third * B[5] || p->dx[j] != child;
+      ox[q] = p->x[j] - B[0], oy[q] = p->y[j] - B[1];
       cx += ox[q] / 3, cy += oy[q] / 3;
-      const double Pc = ((double)p.rho[j] - rho0) * c0 * c0;
-      wrong_pressure += fabs(Pc - (ga * p.x[j] + gb * p.y[j] + gc)) > TOL(1e-5) * 1e4;
+      const double Pc = ((double)p->rho[j] - rho0) * c0 * c0;
+      wrong_pressure += fabs(Pc - (ga * p->x[j] + gb * p->y[j] + gc)) > TOL(1e-5) * 1e4;
     }
     ecentre = fmax(ecentre, hypot(cx, cy) / dx);
     for (int q = 0; q < 3; q++)
@@ -715,13 +718,7 @@ static void test_split_triangle(void) {
   CU_ASSERT(ecentre < TOL(1e-12));
   CU_ASSERT_EQUAL(worse, 0);
   CU_ASSERT(turned > 0);
-  free(want);
-  free(before);
-  free(e);
-  rhod_apr_free(&a);
-  rhod_cells_free(&c);
-  rhod_particles_free(&p);
-  free(sc);
+  split_case_free(&t);
 }
 
 /* A strained lattice, as a dam break's stretching leaves it: rows 2.5 dx apart, particles
