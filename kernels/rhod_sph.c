@@ -9,6 +9,43 @@
 #include <math.h>
 #include <string.h>
 
+/* The gathers of passes A and C are written per particle (pass_a_particle,
+ * pass_c_particle). The host build inlines them into specialised copies (below);
+ * GCC 12's nvptx compiler fails (internal error) on a forced inline inside a target
+ * region, and the device build has one copy anyway. */
+#ifdef RHOD_OFFLOAD
+#define PARTICLE_BODY static inline
+#else
+#define PARTICLE_BODY static inline __attribute__((always_inline))
+#endif
+
+/* Rows of s->pk: the neighbour-side fields of the gathers, copied into the order of
+ * the sorted cells (row r of particle CI[k] at pk[r * cap + k]), so that the inner
+ * loops over a row of cells read them contiguously and vectorise (RHOD_FOR_ROWS).
+ * Pass A packs the first rows (the state), pass C the rest (pass A's gradients, the
+ * shifting velocity and rho). The cells must have been built over the fluid and the
+ * ghosts. */
+enum {
+  PK_X,
+  PK_Y,
+  PK_V,
+  PK_P,
+  PK_UX,
+  PK_UY,
+  PK_DX, /* pass A */
+  PK_D,
+  PK_GPX,
+  PK_GPY,
+  PK_GU0,
+  PK_GU1,
+  PK_GU2,
+  PK_GU3,
+  PK_DUX,
+  PK_DUY,
+  PK_RHO, /* pass C */
+  PK_ROWS
+};
+
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   memset(s, 0, sizeof *s);
   s->kernel = sc->kernel;
@@ -60,6 +97,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   F(reg, 1);
   if (s->visc_cons) /* a scene without it does not carry it */
     F(lapB, 3);
+  F(pk, PK_ROWS);
 #undef F
   return st;
 }
@@ -91,127 +129,197 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
   }
 }
 
+static void pack_a(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
+  const long nt = (long)(p->n + p->ng), st = (long)p->cap;
+  const int32_t *CI = c->idx;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *dx = p->dx, *P = s->P, *V = s->V;
+  real *pk = s->pk;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt; k++) {
+    const int j = CI[k];
+    pk[PK_X * st + k] = x[j], pk[PK_Y * st + k] = y[j], pk[PK_V * st + k] = V[j];
+    pk[PK_P * st + k] = P[j], pk[PK_UX * st + k] = ux[j], pk[PK_UY * st + k] = uy[j];
+    pk[PK_DX * st + k] = dx[j];
+  }
+}
+
+static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
+  const long nt = (long)(p->n + p->ng), st = (long)p->cap;
+  const int32_t *CI = c->idx;
+  const real *D = s->D, *gP = s->gP, *gu = s->gu, *du = s->du, *rho = p->rho;
+  real *pk = s->pk;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt; k++) {
+    const int j = CI[k];
+    pk[PK_D * st + k] = D[j];
+    pk[PK_GPX * st + k] = gP[2 * j], pk[PK_GPY * st + k] = gP[2 * j + 1];
+    pk[PK_GU0 * st + k] = gu[4 * j], pk[PK_GU1 * st + k] = gu[4 * j + 1];
+    pk[PK_GU2 * st + k] = gu[4 * j + 2], pk[PK_GU3 * st + k] = gu[4 * j + 3];
+    pk[PK_DUX * st + k] = du[2 * j], pk[PK_DUY * st + k] = du[2 * j + 1];
+    pk[PK_RHO * st + k] = rho[j];
+  }
+}
+
 /* Pass A: Gamma, grad Gamma, B = L^-1, raw gradients of P and u, div u, grad C,
- * U_char; then L, the renormalised gradients (Eq. 14) and lambda, per particle. */
+ * U_char; then L, the renormalised gradients (Eq. 14) and lambda, per particle. As in
+ * pass C (below), the gather of one particle is an inlined function: the host build
+ * compiles a copy for the default kernel in which it is a constant. */
+#define PA_PARAMS                                                                                  \
+  rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
+      const real *dx, const real *P, const real *V, const real *pk, long st, real *gam,            \
+      real *ggam, real *L, real *gP, real *gu, real *D, real *gC, real *uch, real *lam,            \
+      real *lapB, const real ratio, const int vcons
+#define PA_ARGS                                                                                    \
+  G, CS, x, y, ux, uy, dx, P, V, pk, st, gam, ggam, L, gP, gu, D, gC, uch, lam, lapB, ratio, vcons
+
+PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
+  const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st, *kP = pk + PK_P * st,
+             *kux = pk + PK_UX * st, *kuy = pk + PK_UY * st, *kdx = pk + PK_DX * st;
+  const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
+  const real uxi = ux[i], uyi = uy[i], Pi = P[i], dxi = dx[i];
+  const real iR = 1 / Ri, iR2 = iR * iR, iR3 = iR2 * iR;
+  real g = rhod_Wq(kern, 0) * iR2 * V[i];        /* self term of Eq. 7 */
+  const real iWdx = 1 / rhod_Wq(kern, dxi * iR); /* R^-2/W(dx_ij) of Eq. 29, dx_j = dx_i */
+  real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
+  real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0, um = 0;
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+    RHOD_SIMD(reduction(+ : g, ggx, ggy, B0, B1, B2, B3, GPx, GPy, Gu0, Gu1, Gu2, Gu3, div, cx,
+                        cy) reduction(max : um))
+    for (int k = k0; k < k1; k++) {
+      const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
+      /* r = 0: i itself (see pass C) */
+      if (!(r2 < R2 && r2 > 0))
+        continue;
+      const real r = sqrt(r2), ir = 1 / r;
+      const real nx = rx * ir, ny = ry * ir;
+      const real Vj = kV[k];
+      const real q = r * iR;
+      const real F = -rhod_dWq(kern, q) * iR3 * Vj; /* |grad_i W_ij| V_j */
+      const real Wq = rhod_Wq(kern, q), Wv = Wq * iR2 * Vj;
+      const real gwx = F * nx, gwy = F * ny;
+      g += Wv;                        /* Eq. 7 */
+      ggx += gwx, ggy += gwy;         /* Eq. 27 */
+      B0 += rx * gwx, B1 += rx * gwy; /* Eq. 8: B_ab = sum r_a g_b V */
+      B2 += ry * gwx, B3 += ry * gwy;
+      const real dP = kP[k] - Pi, dux = kux[k] - uxi, duy = kuy[k] - uyi;
+      GPx += dP * gwx, GPy += dP * gwy; /* Eq. 14, raw */
+      Gu0 += dux * gwx, Gu1 += dux * gwy;
+      Gu2 += duy * gwx, Gu3 += duy * gwy;
+      div += dux * gwx + duy * gwy; /* Eq. 5 */
+      /* Eq. 29: [1 + 0.2 (W_ij / W(dx_ij))^4] grad_i W_ij V_j, W(dx_ij) with R_i */
+      const real dxj = kdx[k];
+      const real wr = dxj == dxi ? Wq * iWdx : Wq / rhod_Wq(kern, (real)0.5 * (dxi + dxj) * iR);
+      const real f = 1 + (real)0.2 * wr * wr * wr * wr;
+      cx += f * gwx, cy += f * gwy;
+      const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
+      um = un > um ? un : um;
+    }
+  }
+  RHOD_END_ROWS
+  gam[i] = g;
+  ggam[2 * i] = ggx, ggam[2 * i + 1] = ggy;
+  D[i] = div;
+  gC[2 * i] = cx, gC[2 * i + 1] = cy;
+  uch[i] = um;
+  const real Bm[4] = {B0, B1, B2, B3};
+  lam[i] = rhod_min_eig_sym(Bm);
+  /* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
+   * invert: isolated particles, thin jets) L = identity, so the gradients fall
+   * back to the plain SPH sums. */
+  const real det = B0 * B3 - B1 * B2;
+  real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
+  if (det > (real)1e-2) {
+    const real id = 1 / det;
+    L0 = B3 * id, L1 = -B1 * id, L2 = -B2 * id, L3 = B0 * id;
+  }
+  L[4 * i] = L0, L[4 * i + 1] = L1, L[4 * i + 2] = L2, L[4 * i + 3] = L3;
+  /* exact for linear fields: sum (a.r) g V = B^T a, so grad = L^T G (scheme.md) */
+  gP[2 * i] = L0 * GPx + L2 * GPy;
+  gP[2 * i + 1] = L1 * GPx + L3 * GPy;
+  gu[4 * i] = L0 * Gu0 + L2 * Gu1;
+  gu[4 * i + 1] = L1 * Gu0 + L3 * Gu1;
+  gu[4 * i + 2] = L0 * Gu2 + L2 * Gu3;
+  gu[4 * i + 3] = L1 * Gu2 + L3 * Gu3;
+  if (vcons) {
+    /* moments of the consistent Laplacian: T = sum F r n n n n, Q = sum F n n n, P3 =
+     * sum F r^2 n n n (fully symmetric; digits count the x and y indices), in a loop of
+     * their own so that a scene without it pays nothing */
+    real T40 = 0, T31 = 0, T22 = 0, T13 = 0, T04 = 0;
+    real Q30 = 0, Q21 = 0, Q12 = 0, Q03 = 0, P30 = 0, P21 = 0, P12 = 0, P03 = 0;
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+      RHOD_SIMD(reduction(+ : T40, T31, T22, T13, T04, Q30, Q21, Q12, Q03, P30, P21, P12, P03))
+      for (int k = k0; k < k1; k++) {
+        const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
+        if (!(r2 < R2 && r2 > 0))
+          continue;
+        const real r = sqrt(r2), ir = 1 / r;
+        const real nx = rx * ir, ny = ry * ir;
+        const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
+        const real exx = nx * nx, exy = nx * ny, eyy = ny * ny, a = F * r, b = F * r2;
+        T40 += a * exx * exx, T31 += a * exx * exy, T22 += a * exx * eyy;
+        T13 += a * exy * eyy, T04 += a * eyy * eyy;
+        Q30 += F * exx * nx, Q21 += F * exx * ny, Q12 += F * eyy * nx, Q03 += F * eyy * ny;
+        P30 += b * exx * nx, P21 += b * exx * ny, P12 += b * eyy * nx, P03 += b * eyy * ny;
+      }
+    }
+    RHOD_END_ROWS
+    /* The consistent Laplacian (our choice for scheme.viscosity: consistent, in the
+     * manner of Fatehi & Manzari 2011; paper 002 names such higher-order operators
+     * after Eq. 10 without giving one): lap f_i = B^ : sum_j 2 F n n ((f_j - f_i)/r -
+     * n . grad f_i), grad f the renormalised gradient above. A Taylor expansion gives
+     * sum = T' : H with T'_abcd = T_abcd - Q_abm M_mcd, M = L^T P3 (the gradient's
+     * own error on a quadratic field), so B^ solves B^_ab T'_abcd = delta_cd and the
+     * operator is exact for quadratic fields on any cloud (tests/test_kernels.c). On
+     * a lattice T' = (delta delta + 2 sym) / 4 and B^ = I. */
+    const real Mx0 = L0 * P30 + L2 * P21, Mx1 = L0 * P21 + L2 * P12, Mx2 = L0 * P12 + L2 * P03;
+    const real My0 = L1 * P30 + L3 * P21, My1 = L1 * P21 + L3 * P12, My2 = L1 * P12 + L3 * P03;
+    /* T'_(ab)(cd), ab and cd in xx (0), xy (1), yy (2) */
+    const real t00 = T40 - (Q30 * Mx0 + Q21 * My0), t01 = T31 - (Q30 * Mx1 + Q21 * My1),
+               t02 = T22 - (Q30 * Mx2 + Q21 * My2);
+    const real t10 = T31 - (Q21 * Mx0 + Q12 * My0), t11 = T22 - (Q21 * Mx1 + Q12 * My1),
+               t12 = T13 - (Q21 * Mx2 + Q12 * My2);
+    const real t20 = T22 - (Q12 * Mx0 + Q03 * My0), t21 = T13 - (Q12 * Mx1 + Q03 * My1),
+               t22 = T04 - (Q12 * Mx2 + Q03 * My2);
+    /* rows cd = xx, yy, xy; unknowns (B^xx, B^xy, B^yy); right side (1, 1, 0) */
+    const real a00 = t00, a01 = 2 * t10, a02 = t20;
+    const real a10 = t02, a11 = 2 * t12, a12 = t22;
+    const real a20 = t01, a21 = 2 * t11, a22 = t21;
+    const real det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) +
+                     a02 * (a10 * a21 - a11 * a20);
+    real bxx = 0, bxy = 0, byy = 0;
+    /* our choice: |det| below a tenth of the full support's 1/4 leaves B^ = 0, and
+     * pass C uses Eq. 10 for that particle */
+    if (fabs(det) > (real)0.025) {
+      const real id = 1 / det;
+      bxx = ((a11 * a22 - a12 * a21) - (a01 * a22 - a02 * a21)) * id;
+      bxy = ((a00 * a22 - a02 * a20) - (a10 * a22 - a12 * a20)) * id;
+      byy = ((a10 * a21 - a11 * a20) - (a00 * a21 - a01 * a20)) * id;
+    }
+    lapB[3 * i] = bxx, lapB[3 * i + 1] = bxy, lapB[3 * i + 2] = byy;
+  }
+}
+
 void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
-  const long n = (long)p->n;
+  pack_a(s, p, c);
+  const long n = (long)p->n, st = (long)p->cap;
   const rhod_grid G = c->g;
-  const int32_t *CS = c->start, *CI = c->idx;
+  const int32_t *CS = c->start;
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *dx = p->dx;
-  const real *P = s->P, *V = s->V;
+  const real *P = s->P, *V = s->V, *pk = s->pk;
   real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *gC = s->gC,
        *uch = s->uch, *lam = s->lam, *lapB = s->lapB;
   const int kern = s->kernel, vcons = s->visc_cons;
   const real ratio = s->ratio;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
-    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
-    const real uxi = ux[i], uyi = uy[i], Pi = P[i], dxi = dx[i];
-    const real iR = 1 / Ri, iR2 = iR * iR, iR3 = iR2 * iR;
-    real g = rhod_Wq(kern, 0) * iR2 * V[i];        /* self term of Eq. 7 */
-    const real iWdx = 1 / rhod_Wq(kern, dxi * iR); /* R^-2/W(dx_ij) of Eq. 29, dx_j = dx_i */
-    real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
-    real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0, um = 0;
-    /* moments of the consistent Laplacian (scheme.viscosity: consistent): T = sum F r
-     * n n n n, Q = sum F n n n, P3 = sum F r^2 n n n (fully symmetric; digits count the
-     * x and y indices) */
-    real T40 = 0, T31 = 0, T22 = 0, T13 = 0, T04 = 0;
-    real Q30 = 0, Q21 = 0, Q12 = 0, Q03 = 0, P30 = 0, P21 = 0, P12 = 0, P03 = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
-      if (r2 < R2 && j != i) {
-        const real r = sqrt(r2), ir = 1 / r;
-        const real nx = rx * ir, ny = ry * ir;
-        const real Vj = V[j];
-        const real q = r * iR;
-        const real F = -rhod_dWq(kern, q) * iR3 * Vj; /* |grad_i W_ij| V_j */
-        const real Wq = rhod_Wq(kern, q), Wv = Wq * iR2 * Vj;
-        const real gwx = F * nx, gwy = F * ny;
-        g += Wv;                        /* Eq. 7 */
-        ggx += gwx, ggy += gwy;         /* Eq. 27 */
-        B0 += rx * gwx, B1 += rx * gwy; /* Eq. 8: B_ab = sum r_a g_b V */
-        B2 += ry * gwx, B3 += ry * gwy;
-        const real dP = P[j] - Pi, dux = ux[j] - uxi, duy = uy[j] - uyi;
-        GPx += dP * gwx, GPy += dP * gwy; /* Eq. 14, raw */
-        Gu0 += dux * gwx, Gu1 += dux * gwy;
-        Gu2 += duy * gwx, Gu3 += duy * gwy;
-        div += dux * gwx + duy * gwy; /* Eq. 5 */
-        /* Eq. 29: [1 + 0.2 (W_ij / W(dx_ij))^4] grad_i W_ij V_j, W(dx_ij) with R_i */
-        const real dxj = dx[j];
-        const real wr = dxj == dxi ? Wq * iWdx : Wq / rhod_Wq(kern, (real)0.5 * (dxi + dxj) * iR);
-        const real f = 1 + (real)0.2 * wr * wr * wr * wr;
-        cx += f * gwx, cy += f * gwy;
-        const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
-        um = un > um ? un : um;
-        if (vcons) {
-          const real exx = nx * nx, exy = nx * ny, eyy = ny * ny, a = F * r, b = F * r2;
-          T40 += a * exx * exx, T31 += a * exx * exy, T22 += a * exx * eyy;
-          T13 += a * exy * eyy, T04 += a * eyy * eyy;
-          Q30 += F * exx * nx, Q21 += F * exx * ny, Q12 += F * eyy * nx, Q03 += F * eyy * ny;
-          P30 += b * exx * nx, P21 += b * exx * ny, P12 += b * eyy * nx, P03 += b * eyy * ny;
-        }
-      }
-    }
-    RHOD_END_NEIGHBOURS
-    gam[i] = g;
-    ggam[2 * i] = ggx, ggam[2 * i + 1] = ggy;
-    D[i] = div;
-    gC[2 * i] = cx, gC[2 * i + 1] = cy;
-    uch[i] = um;
-    const real Bm[4] = {B0, B1, B2, B3};
-    lam[i] = rhod_min_eig_sym(Bm);
-    /* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
-     * invert: isolated particles, thin jets) L = identity, so the gradients fall
-     * back to the plain SPH sums. */
-    const real det = B0 * B3 - B1 * B2;
-    real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
-    if (det > (real)1e-2) {
-      const real id = 1 / det;
-      L0 = B3 * id, L1 = -B1 * id, L2 = -B2 * id, L3 = B0 * id;
-    }
-    L[4 * i] = L0, L[4 * i + 1] = L1, L[4 * i + 2] = L2, L[4 * i + 3] = L3;
-    /* exact for linear fields: sum (a.r) g V = B^T a, so grad = L^T G (scheme.md) */
-    gP[2 * i] = L0 * GPx + L2 * GPy;
-    gP[2 * i + 1] = L1 * GPx + L3 * GPy;
-    gu[4 * i] = L0 * Gu0 + L2 * Gu1;
-    gu[4 * i + 1] = L1 * Gu0 + L3 * Gu1;
-    gu[4 * i + 2] = L0 * Gu2 + L2 * Gu3;
-    gu[4 * i + 3] = L1 * Gu2 + L3 * Gu3;
-    if (vcons) {
-      /* The consistent Laplacian (our choice for scheme.viscosity: consistent, in the
-       * manner of Fatehi & Manzari 2011; paper 002 names such higher-order operators
-       * after Eq. 10 without giving one): lap f_i = B^ : sum_j 2 F n n ((f_j - f_i)/r -
-       * n . grad f_i), grad f the renormalised gradient above. A Taylor expansion gives
-       * sum = T' : H with T'_abcd = T_abcd - Q_abm M_mcd, M = L^T P3 (the gradient's
-       * own error on a quadratic field), so B^ solves B^_ab T'_abcd = delta_cd and the
-       * operator is exact for quadratic fields on any cloud (tests/test_kernels.c). On
-       * a lattice T' = (delta delta + 2 sym) / 4 and B^ = I. */
-      const real Mx0 = L0 * P30 + L2 * P21, Mx1 = L0 * P21 + L2 * P12, Mx2 = L0 * P12 + L2 * P03;
-      const real My0 = L1 * P30 + L3 * P21, My1 = L1 * P21 + L3 * P12, My2 = L1 * P12 + L3 * P03;
-      /* T'_(ab)(cd), ab and cd in xx (0), xy (1), yy (2) */
-      const real t00 = T40 - (Q30 * Mx0 + Q21 * My0), t01 = T31 - (Q30 * Mx1 + Q21 * My1),
-                 t02 = T22 - (Q30 * Mx2 + Q21 * My2);
-      const real t10 = T31 - (Q21 * Mx0 + Q12 * My0), t11 = T22 - (Q21 * Mx1 + Q12 * My1),
-                 t12 = T13 - (Q21 * Mx2 + Q12 * My2);
-      const real t20 = T22 - (Q12 * Mx0 + Q03 * My0), t21 = T13 - (Q12 * Mx1 + Q03 * My1),
-                 t22 = T04 - (Q12 * Mx2 + Q03 * My2);
-      /* rows cd = xx, yy, xy; unknowns (B^xx, B^xy, B^yy); right side (1, 1, 0) */
-      const real a00 = t00, a01 = 2 * t10, a02 = t20;
-      const real a10 = t02, a11 = 2 * t12, a12 = t22;
-      const real a20 = t01, a21 = 2 * t11, a22 = t21;
-      const real det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) +
-                       a02 * (a10 * a21 - a11 * a20);
-      real bxx = 0, bxy = 0, byy = 0;
-      /* our choice: |det| below a tenth of the full support's 1/4 leaves B^ = 0, and
-       * pass C uses Eq. 10 for that particle */
-      if (fabs(det) > (real)0.025) {
-        const real id = 1 / det;
-        bxx = ((a11 * a22 - a12 * a21) - (a01 * a22 - a02 * a21)) * id;
-        bxy = ((a00 * a22 - a02 * a20) - (a10 * a22 - a12 * a20)) * id;
-        byy = ((a10 * a21 - a11 * a20) - (a00 * a21 - a01 * a20)) * id;
-      }
-      lapB[3 * i] = bxx, lapB[3 * i + 1] = bxy, lapB[3 * i + 2] = byy;
-    }
+#ifdef RHOD_OFFLOAD
+    pass_a_particle(i, PA_ARGS, kern);
+#else
+    if (kern == RHOD_KERNEL_WENDLAND_C2)
+      pass_a_particle(i, PA_ARGS, RHOD_KERNEL_WENDLAND_C2);
+    else
+      pass_a_particle(i, PA_ARGS, kern);
+#endif
   }
 }
 
@@ -433,134 +541,206 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
   }
 }
 
-/* Pass C: the right-hand side of Eq. 3. */
-void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
-  const long n = (long)p->n;
-  const rhod_grid G = c->g;
-  const int32_t *CS = c->start, *CI = c->idx;
-  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *dx = p->dx;
-  const real *P = s->P, *V = s->V, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *du = s->du,
-             *gam = s->gam;
-  const uint8_t *reg = s->reg;
-  real *drho = s->drho, *acc = s->acc, *vel = s->vel;
-  const int kern = s->kernel, riemann = s->riemann, recon = s->recon, damper = s->damper,
-            shifting = s->shifting;
-  const real ratio = s->ratio, c0 = s->c0, rho0 = s->rho0, ic2 = 1 / (s->c0 * s->c0);
-  const real alpha_mu = s->mu != 0 ? 1 : 0, gx = s->gx, gy = s->gy;
-  const real alpha_ad = damper ? s->alpha_ad : 0, gth = s->gamma_th, tth = s->theta_th;
-  const real visc_k = 2 * (RHOD_DIM + 2) * s->mu; /* Eq. 10 */
-  const real *lapB = s->lapB, s_mu = s->mu;
-  const int vcons = s->visc_cons;
+/* Pass C: the right-hand side of Eq. 3. The gather of one particle is an inlined
+ * function, so that the host build can compile specialised copies of it in which the
+ * scene's switches (kernel, Riemann terms, reconstruction, shifting, viscosity) are
+ * constants: a switched-off term then costs nothing, and the neighbour loop has no
+ * branch and vectorises (RHOD_SIMD). The device build keeps one copy (its lanes are
+ * particles, and a branch on a switch is uniform across them). */
+typedef struct {
+  real ratio, c0, rho0, ic2, gx, gy, alpha_ad, gth, tth, visc_k, mu;
+  int vcons;
+} pass_c_consts;
+
+#define PC_PARAMS                                                                                  \
+  rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
+      const real *rho, const real *dx, const real *P, const real *L, const real *gP,               \
+      const real *gu, const real *D, const real *du, const real *gam, const uint8_t *reg,          \
+      const real *lapB, const real *pk, long st, real *drho, real *acc, real *vel,                 \
+      const pass_c_consts K
+#define PC_ARGS                                                                                    \
+  G, CS, x, y, ux, uy, rho, dx, P, L, gP, gu, D, du, gam, reg, lapB, pk, st, drho, acc, vel, K
+
+PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int riemann,
+                                   const int recon, const int shifting, const int visc) {
+  const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st, *kP = pk + PK_P * st,
+             *kux = pk + PK_UX * st, *kuy = pk + PK_UY * st, *kdx = pk + PK_DX * st,
+             *kD = pk + PK_D * st, *kgPx = pk + PK_GPX * st, *kgPy = pk + PK_GPY * st,
+             *kg0 = pk + PK_GU0 * st, *kg1 = pk + PK_GU1 * st, *kg2 = pk + PK_GU2 * st,
+             *kg3 = pk + PK_GU3 * st, *kdux = pk + PK_DUX * st, *kduy = pk + PK_DUY * st,
+             *krho = pk + PK_RHO * st;
+  const real c0 = K.c0, rho0 = K.rho0, ic2 = K.ic2;
+  const real xi = x[i], yi = y[i], dxi = dx[i], Ri = K.ratio * dxi, R2 = Ri * Ri;
+  const real iR = 1 / Ri, iR3 = iR * iR * iR;
+  const real uxi = ux[i], uyi = uy[i], rhoi = rho[i], Pi = P[i], Di = D[i];
+  const real dui = du[2 * i], dvi = du[2 * i + 1];
+  const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];
+  const real Gi0 = gu[4 * i], Gi1 = gu[4 * i + 1], Gi2 = gu[4 * i + 2], Gi3 = gu[4 * i + 3];
+  /* Which sums are renormalised is known before the loop (Eq. 6: i in I and
+   * Gamma_i >= 0.85; Eq. 24: i in I and Gamma_i > 0.95), so the pressure, Theta^u
+   * and damper sums share two vector accumulators: vR (multiplied by L^T after the
+   * loop) and vC (used as is); sf = sum grad_i W_ij V_j carries the P_i and D_i
+   * parts. */
+  const int inner = reg[i] == 0;
+  const real renP = (inner && gam[i] >= K.gth) ? 1 : 0;
+  const real renT = (inner && gam[i] > K.tth) ? 1 : 0;
   /* Theta^u only without viscosity: the alpha_mu exclusion of Eq. 3 */
-  const int theta_u = riemann && alpha_mu == 0;
-  RHOD_KERNEL_LOOP
-  for (long i = 0; i < n; i++) {
-    const real xi = x[i], yi = y[i], dxi = dx[i], Ri = ratio * dxi, R2 = Ri * Ri;
-    const real iR = 1 / Ri, iR3 = iR * iR * iR;
-    const real uxi = ux[i], uyi = uy[i], rhoi = rho[i], Pi = P[i], Di = D[i];
-    const real dui = du[2 * i], dvi = du[2 * i + 1];
-    const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];
-    const real *Gi = gu + 4 * i;
-    /* Which sums are renormalised is known before the loop (Eq. 6: i in I and
-     * Gamma_i >= 0.85; Eq. 24: i in I and Gamma_i > 0.95), so the pressure, Theta^u
-     * and damper sums share two vector accumulators: vR (multiplied by L^T after the
-     * loop) and vC (used as is); sf = sum grad_i W_ij V_j carries the P_i and D_i
-     * parts. */
-    const int inner = reg[i] == 0;
-    const real renP = (inner && gam[i] >= gth) ? 1 : 0;
-    /* the consistent Laplacian where the pressure gradient is renormalised and B^ was
-     * solved (pass A); elsewhere Eq. 10 */
-    real bxx = 0, bxy = 0, byy = 0;
-    if (vcons && renP != 0)
-      bxx = lapB[3 * i], bxy = lapB[3 * i + 1], byy = lapB[3 * i + 2];
-    const int lapc = bxx + byy != 0;
-    const real renT = (inner && gam[i] > tth) ? 1 : 0;
-    const real kAD = alpha_ad * rho0 * c0 * (real)0.5 * Ri; /* Eq. 9, h_i = R_i/2 */
-    real vRx = 0, vRy = 0, vCx = 0, vCy = 0, sfx = 0, sfy = 0;
-    real cont = 0;                              /* continuity, Eq. 22 */
-    real vsx = 0, vsy = 0;                      /* Eq. 10 */
-    real ddu = 0, drdu = 0, ruux = 0, ruuy = 0; /* Eq. 4 */
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
-      if (r2 < R2 && j != i) {
-        const real r = sqrt(r2), ir = 1 / r;
-        const real nx = rx * ir, ny = ry * ir;
-        const real F = -rhod_dWq(kern, r * iR) * iR3 * V[j]; /* |grad_i W_ij| V_j */
-        const real fx = F * nx, fy = F * ny;
-        const real Pj = P[j];
-        real aR = renP * Pj, aC = (1 - renP) * Pj - kAD * D[j];
-        sfx += fx, sfy += fy;
-        const real uni = uxi * nx + uyi * ny, unj = ux[j] * nx + uy[j] * ny;
-        if (riemann) {
-          /* weights of Eq. 12: w_i = dx_i / (dx_i + dx_j) (1/2 at equal sizes) */
-          const real dxj = dx[j];
-          const real wi = dxj == dxi ? (real)0.5 : dxi / (dxi + dxj), wj = 1 - wi;
-          /* states of Eqs. 13-16 for P and the normal velocity u.n_ij */
-          const real *Gj = gu + 4 * j;
+  const real tR = (riemann && !visc) ? renT : 0, tC = (riemann && !visc) ? 1 - renT : 0;
+  /* the consistent Laplacian where the pressure gradient is renormalised and B^ was
+   * solved (pass A), with mu folded in; elsewhere Eq. 10 (weight e10) */
+  real bxx = 0, bxy = 0, byy = 0;
+  if (visc && K.vcons && renP != 0)
+    bxx = K.mu * lapB[3 * i], bxy = K.mu * lapB[3 * i + 1], byy = K.mu * lapB[3 * i + 2];
+  const real e10 = (bxx + byy != 0) ? 0 : K.visc_k;
+  const real kAD = K.alpha_ad * rho0 * c0 * (real)0.5 * Ri; /* Eq. 9, h_i = R_i/2 */
+  real vRx = 0, vRy = 0, vCx = 0, vCy = 0, sfx = 0, sfy = 0;
+  real cont = 0;                              /* continuity, Eq. 22 */
+  real vsx = 0, vsy = 0;                      /* F^mu */
+  real ddu = 0, drdu = 0, ruux = 0, ruuy = 0; /* Eq. 4 */
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+    RHOD_SIMD(reduction(+ : vRx, vRy, vCx, vCy, sfx, sfy, cont, vsx, vsy, ddu, drdu, ruux, ruuy))
+    for (int k = k0; k < k1; k++) {
+      const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
+      /* r = 0: i itself (a particle on top of another would have no n_ij either) */
+      if (!(r2 < R2 && r2 > 0))
+        continue;
+      const real r = sqrt(r2), ir = 1 / r;
+      const real nx = rx * ir, ny = ry * ir;
+      const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k]; /* |grad_i W_ij| V_j */
+      const real fx = F * nx, fy = F * ny;
+      const real Pj = kP[k], uxj = kux[k], uyj = kuy[k];
+      real aR = renP * Pj, aC = (1 - renP) * Pj - kAD * kD[k];
+      sfx += fx, sfy += fy;
+      const real uni = uxi * nx + uyi * ny, unj = uxj * nx + uyj * ny;
+      if (riemann) {
+        /* weights of Eq. 12: w_i = dx_i / (dx_i + dx_j) (1/2 at equal sizes) */
+        const real dxj = kdx[k];
+        const real wi = dxj == dxi ? (real)0.5 : dxi / (dxi + dxj), wj = 1 - wi;
+        /* states of Eqs. 13-16 for P and the normal velocity u.n_ij */
+        real PL = Pi, PR = Pj, uL = uni, uR = unj;
+        if (recon) {
           const real gPi_n = gPix * nx + gPiy * ny;
-          const real gPj_n = gP[2 * j] * nx + gP[2 * j + 1] * ny;
-          const real gui_n = nx * (Gi[0] * nx + Gi[1] * ny) + ny * (Gi[2] * nx + Gi[3] * ny);
-          const real guj_n = nx * (Gj[0] * nx + Gj[1] * ny) + ny * (Gj[2] * nx + Gj[3] * ny);
-          real PL, PR, uL, uR, uE, PE;
-          rhod_states(Pi, Pj, gPi_n, gPj_n, r, wi, wj, recon, &PL, &PR);
-          rhod_states(uni, unj, gui_n, guj_n, r, wi, wj, recon, &uL, &uR);
-          rhod_pvrs(rho0 + PL * ic2, rho0 + PR * ic2, uL, uR, PL, PR, c0, &uE, &PE);
-          /* Eq. 22: -rho_i <div u> + Theta^rho = -2 rho_i sum (u_E + R_ij).n F V,
-           * R_ij = -(3/2 - w_i) u_i - (1/2 - w_j) u_j */
-          cont += (uE - ((real)1.5 - wi) * uni - ((real)0.5 - wj) * unj) * F;
-          if (theta_u) {
-            /* Eq. 24: theta_ij = 2 (P_E - [(1 - w_i) P_i + (1 - w_j) P_j]) */
-            const real th = 2 * (PE - ((1 - wi) * Pi + (1 - wj) * Pj));
-            aR += renT * th;
-            aC += (1 - renT) * th;
-          }
-        } else {
-          cont += (unj - uni) * F; /* Eq. 5 */
+          const real gPj_n = kgPx[k] * nx + kgPy[k] * ny;
+          const real gui_n = nx * (Gi0 * nx + Gi1 * ny) + ny * (Gi2 * nx + Gi3 * ny);
+          const real guj_n = nx * (kg0[k] * nx + kg1[k] * ny) + ny * (kg2[k] * nx + kg3[k] * ny);
+          const real sP = (Pj - Pi) * ir, su = (unj - uni) * ir;
+          PL = rhod_state(Pi, sP, gPi_n, wi * r), PR = rhod_state(Pj, sP, gPj_n, -wj * r);
+          uL = rhod_state(uni, su, gui_n, wi * r), uR = rhod_state(unj, su, guj_n, -wj * r);
         }
-        vRx += aR * fx, vRy += aR * fy;
-        vCx += aC * fx, vCy += aC * fy;
-        if (lapc) {
-          /* consistent: 2 F (n.B^.n) ((u_j - u_i)/r - n.grad u_i), see pass A */
-          const real f = 2 * F * (bxx * nx * nx + 2 * bxy * nx * ny + byy * ny * ny);
-          vsx += f * ((ux[j] - uxi) * ir - (Gi[0] * nx + Gi[1] * ny));
-          vsy += f * ((uy[j] - uyi) * ir - (Gi[2] * nx + Gi[3] * ny));
-        } else if (visc_k != 0) {
-          /* pi_ij of Eq. 10 */
-          const real pij = ((ux[j] - uxi) * rx + (uy[j] - uyi) * ry) / r2;
-          vsx += pij * fx, vsy += pij * fy;
+        const real rhoL = rho0 + PL * ic2, rhoR = rho0 + PR * ic2;
+        const real uE = rhod_pvrs_u(rhoL, rhoR, uL, uR, PL, PR, c0);
+        /* Eq. 22: -rho_i <div u> + Theta^rho = -2 rho_i sum (u_E + R_ij).n F V,
+         * R_ij = -(3/2 - w_i) u_i - (1/2 - w_j) u_j */
+        cont += (uE - ((real)1.5 - wi) * uni - ((real)0.5 - wj) * unj) * F;
+        if (!visc) {
+          /* Eq. 24: theta_ij = 2 (P_E - [(1 - w_i) P_i + (1 - w_j) P_j]) */
+          const real PE = rhod_pvrs_P(rhoL, rhoR, uL, uR, PL, PR, c0);
+          const real th = 2 * (PE - ((1 - wi) * Pi + (1 - wj) * Pj));
+          aR += tR * th;
+          aC += tC * th;
         }
-        if (shifting) {
-          const real duj = du[2 * j], dvj = du[2 * j + 1], rhoj = rho[j];
-          const real dun_i = dui * nx + dvi * ny, dun_j = duj * nx + dvj * ny;
-          ddu += (dun_j - dun_i) * F;
-          drdu += (rhoi * dun_i + rhoj * dun_j) * F;
-          ruux += (rhoi * uxi * dun_i + rhoj * ux[j] * dun_j) * F;
-          ruuy += (rhoi * uyi * dun_i + rhoj * uy[j] * dun_j) * F;
-        }
+      } else {
+        cont += (unj - uni) * F; /* Eq. 5 */
+      }
+      vRx += aR * fx, vRy += aR * fy;
+      vCx += aC * fx, vCy += aC * fy;
+      if (visc) {
+        /* consistent: mu 2 F (n.B^.n) ((u_j - u_i)/r - n.grad u_i), see pass A; Eq. 10:
+         * 2 (d + 2) mu pi_ij grad_i W_ij V_j */
+        const real fc = 2 * F * (bxx * nx * nx + 2 * bxy * nx * ny + byy * ny * ny);
+        const real pij = e10 * ((uxj - uxi) * rx + (uyj - uyi) * ry) * ir * ir;
+        vsx += fc * ((uxj - uxi) * ir - (Gi0 * nx + Gi1 * ny)) + pij * fx;
+        vsy += fc * ((uyj - uyi) * ir - (Gi2 * nx + Gi3 * ny)) + pij * fy;
+      }
+      if (shifting) {
+        const real duj = kdux[k], dvj = kduy[k], rhoj = krho[k];
+        const real dun_i = dui * nx + dvi * ny, dun_j = duj * nx + dvj * ny;
+        ddu += (dun_j - dun_i) * F;
+        drdu += (rhoi * dun_i + rhoj * dun_j) * F;
+        ruux += (rhoi * uxi * dun_i + rhoj * uxj * dun_j) * F;
+        ruuy += (rhoi * uyi * dun_i + rhoj * uyj * dun_j) * F;
       }
     }
-    RHOD_END_NEIGHBOURS
-    const real *Li = L + 4 * i;
-    /* renormalised part: L^T (vR - renP P_i sf) */
-    const real wx = vRx - renP * Pi * sfx, wy = vRy - renP * Pi * sfy;
-    /* plain part: vC + ((1 - renP) P_i - kAD D_i) sf, i.e. sum (P_j + P_i) gW V for a
-     * conservative Eq. 6, and -F^AD of Eq. 9 */
-    const real ki = (1 - renP) * Pi - kAD * Di;
-    real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * gx;
-    real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * gy;
-    /* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
-    real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
-    if (lapc) /* F^mu = mu lap u */
-      fx += s_mu * vsx, fy += s_mu * vsy;
-    else if (visc_k != 0)
-      fx += alpha_mu * visc_k * vsx, fy += alpha_mu * visc_k * vsy;
-    if (shifting) { /* Eq. 4 */
-      dr += -rhoi * ddu + drdu;
-      fx += ruux, fy += ruuy;
+  }
+  RHOD_END_ROWS
+  const real *Li = L + 4 * i;
+  /* renormalised part: L^T (vR - renP P_i sf) */
+  const real wx = vRx - renP * Pi * sfx, wy = vRy - renP * Pi * sfy;
+  /* plain part: vC + ((1 - renP) P_i - kAD D_i) sf, i.e. sum (P_j + P_i) gW V for a
+   * conservative Eq. 6, and -F^AD of Eq. 9 */
+  const real ki = (1 - renP) * Pi - kAD * Di;
+  real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * K.gx + vsx;
+  real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * K.gy + vsy;
+  /* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
+  real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
+  if (shifting) { /* Eq. 4 */
+    dr += -rhoi * ddu + drdu;
+    fx += ruux, fy += ruuy;
+  }
+  drho[i] = dr;
+  acc[2 * i] = fx / rhoi, acc[2 * i + 1] = fy / rhoi;
+  vel[2 * i] = uxi + dui, vel[2 * i + 1] = uyi + dvi;
+}
+
+/* the specialised copies: Wendland C2 (the default kernel) with every combination of
+ * the switches; other kernels take the general copy */
+#define PC_CALL(KERN, RI, RE, SH, VI) pass_c_particle(i, PC_ARGS, KERN, RI, RE, SH, VI)
+#define PC_CASES(B, RI, RE)                                                                        \
+  case B:                                                                                          \
+    PC_CALL(RHOD_KERNEL_WENDLAND_C2, RI, RE, 0, 0);                                                \
+    break;                                                                                         \
+  case B + 1:                                                                                      \
+    PC_CALL(RHOD_KERNEL_WENDLAND_C2, RI, RE, 0, 1);                                                \
+    break;                                                                                         \
+  case B + 2:                                                                                      \
+    PC_CALL(RHOD_KERNEL_WENDLAND_C2, RI, RE, 1, 0);                                                \
+    break;                                                                                         \
+  case B + 3:                                                                                      \
+    PC_CALL(RHOD_KERNEL_WENDLAND_C2, RI, RE, 1, 1);                                                \
+    break;
+
+void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+  pack_c(s, p, c);
+  const long n = (long)p->n, st = (long)p->cap;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *dx = p->dx;
+  const real *P = s->P, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *du = s->du, *gam = s->gam,
+             *lapB = s->lapB, *pk = s->pk;
+  const uint8_t *reg = s->reg;
+  real *drho = s->drho, *acc = s->acc, *vel = s->vel;
+  const pass_c_consts K = {
+      .ratio = s->ratio,
+      .c0 = s->c0,
+      .rho0 = s->rho0,
+      .ic2 = 1 / (s->c0 * s->c0),
+      .gx = s->gx,
+      .gy = s->gy,
+      .alpha_ad = s->damper ? s->alpha_ad : 0,
+      .gth = s->gamma_th,
+      .tth = s->theta_th,
+      .visc_k = 2 * (RHOD_DIM + 2) * s->mu, /* Eq. 10 */
+      .mu = s->mu,
+      .vcons = s->visc_cons,
+  };
+  const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
+            shifting = s->shifting, visc = s->mu != 0;
+  const int sel =
+      kern != RHOD_KERNEL_WENDLAND_C2 ? -1 : 4 * (riemann + recon) + 2 * shifting + visc;
+  (void)sel;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+#ifdef RHOD_OFFLOAD
+    pass_c_particle(i, PC_ARGS, kern, riemann, recon, shifting, visc);
+#else
+    switch (sel) {
+      PC_CASES(0, 0, 0)
+      PC_CASES(4, 1, 0)
+      PC_CASES(8, 1, 1)
+    default:
+      pass_c_particle(i, PC_ARGS, kern, riemann, recon, shifting, visc);
     }
-    drho[i] = dr;
-    acc[2 * i] = fx / rhoi, acc[2 * i + 1] = fy / rhoi;
-    vel[2 * i] = uxi + dui, vel[2 * i + 1] = uyi + dvi;
+#endif
   }
 }
 

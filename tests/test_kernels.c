@@ -312,36 +312,32 @@ static void test_free_surface_square(void) {
 
 /* PVRS (Eqs. 17, 19) and the limiter (Eq. 15) against hand-worked values. */
 static void test_pvrs_hand_values(void) {
-  real uE, PE;
   /* rho_L = 1000, rho_R = 1002, u_L = 1, u_R = -1, P_L = 0, P_R = 800, c0 = 20:
    * u_E = (1002 * (-1) + 1000 * 1)/2002 + (0 - 800)/(20 * 2002) = -2/2002 - 800/40040
    *     = -0.000999000999 - 0.01998001998 = -0.02097902098
    * P_E = (1002 * 0 + 1000 * 800)/2002 + 1000 * 1002 * 20 * 2 / 2002
    *     = 399.6003996 + 20019.98002 = 20419.58042 */
-  rhod_pvrs(1000, 1002, 1, -1, 0, 800, 20, &uE, &PE);
-  CU_ASSERT_DOUBLE_EQUAL(uE, -0.02097902098, TOL(1e-9, 1e-5));
-  CU_ASSERT_DOUBLE_EQUAL(PE, 20419.58042, TOL(1e-5, 5e-2));
+  CU_ASSERT_DOUBLE_EQUAL(rhod_pvrs_u(1000, 1002, 1, -1, 0, 800, 20), -0.02097902098,
+                         TOL(1e-9, 1e-5));
+  CU_ASSERT_DOUBLE_EQUAL(rhod_pvrs_P(1000, 1002, 1, -1, 0, 800, 20), 20419.58042, TOL(1e-5, 5e-2));
   /* equal states: u_E = u, P_E = P */
-  rhod_pvrs(1000, 1000, 0.3, 0.3, 50, 50, 20, &uE, &PE);
-  CU_ASSERT_DOUBLE_EQUAL(uE, 0.3, 1e-6);
-  CU_ASSERT_DOUBLE_EQUAL(PE, 50, 1e-4);
+  CU_ASSERT_DOUBLE_EQUAL(rhod_pvrs_u(1000, 1000, 0.3, 0.3, 50, 50, 20), 0.3, 1e-6);
+  CU_ASSERT_DOUBLE_EQUAL(rhod_pvrs_P(1000, 1000, 0.3, 0.3, 50, 50, 20), 50, 1e-4);
   CU_ASSERT_DOUBLE_EQUAL(rhod_limit(2, 6), 3.0, 1e-6);
   CU_ASSERT_DOUBLE_EQUAL(rhod_limit(-2, -6), -3.0, 1e-6);
   CU_ASSERT_EQUAL(rhod_limit(2, -6), 0);
   CU_ASSERT_EQUAL(rhod_limit(0, 1), 0);
   /* states of Eq. 16 with w_i = 1/3 (i twice finer): phi_i = 0, phi_j = 3, r = 1, both
    * gradients 3: L = 0 + 1/3 * 3 = 1, R = 3 - 2/3 * 3 = 1 (the linear value at x_ij) */
-  real L, Rr;
-  rhod_states(0, 3, 3, 3, 1, (real)(1.0 / 3), (real)(2.0 / 3), 1, &L, &Rr);
-  CU_ASSERT_DOUBLE_EQUAL(L, 1, 1e-6);
-  CU_ASSERT_DOUBLE_EQUAL(Rr, 1, 1e-6);
+  CU_ASSERT_DOUBLE_EQUAL(rhod_state(0, 3, 3, (real)(1.0 / 3)), 1, 1e-6);
+  CU_ASSERT_DOUBLE_EQUAL(rhod_state(3, 3, 3, -(real)(2.0 / 3)), 1, 1e-6);
   /* states against the limiter of Eq. 15 applied by hand, including opposite signs
    * and zero slopes: phi_i = 1, phi_j = 2, r = 0.5 (s1 = 2), w_i = 0.25 */
   const real gs[] = {3, -1, 0, 2, 0.5, -2, 1e-3, 50};
   for (int a = 0; a < 8; a++)
     for (int b = 0; b < 8; b++) {
-      real l2, r2;
-      rhod_states(1, 2, gs[a], gs[b], (real)0.5, (real)0.25, (real)0.75, 1, &l2, &r2);
+      const real l2 = rhod_state(1, 2, gs[a], (real)(0.25 * 0.5));
+      const real r2 = rhod_state(2, 2, gs[b], -(real)(0.75 * 0.5));
       CU_ASSERT_DOUBLE_EQUAL(l2, 1 + 0.25 * 0.5 * rhod_limit(2, gs[a]), 1e-5);
       CU_ASSERT_DOUBLE_EQUAL(r2, 2 - 0.75 * 0.5 * rhod_limit(2, gs[b]), 1e-5);
     }

@@ -86,6 +86,20 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
  * around (xi, yi) that can lie within Ri (the gathering particle's radius); the body
  * tests the distance against it. */
 #define RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j)                                              \
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0_, k1_)                                                       \
+  for (int k_ = k0_; k_ < k1_; k_++) {                                                             \
+    const int j = (CI)[k_];
+#define RHOD_END_NEIGHBOURS                                                                        \
+  }                                                                                                \
+  RHOD_END_ROWS
+
+/* The same scan as ranges: for each row of cells, [k0, k1) is its contiguous range of
+ * the sorted index (particle CI[k] for k in it). Loops that vectorise over k read
+ * copies of the fields packed in this order (rhod_sph's pk arrays):
+ *
+ *   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+ *     RHOD_SIMD(reduction(+ : sum)) for (int k = k0; k < k1; k++) ... } RHOD_END_ROWS */
+#define RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1)                                                   \
   {                                                                                                \
     const int rc_ = rhod_cell_reach((G), (Ri));                                                    \
     const int cx_ = rhod_cell_coord((xi), (G).ox, (G).inv, (G).nx);                                \
@@ -95,11 +109,8 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
     const int x0_ = cx_ - rc_ > 0 ? cx_ - rc_ : 0;                                                 \
     const int x1_ = cx_ + rc_ < (G).nx - 1 ? cx_ + rc_ : (G).nx - 1;                               \
     for (int yy_ = y0_; yy_ <= y1_; yy_++) {                                                       \
-      const int k0_ = (CS)[yy_ * (G).nx + x0_], k1_ = (CS)[yy_ * (G).nx + x1_ + 1];                \
-      for (int k_ = k0_; k_ < k1_; k_++) {                                                         \
-        const int j = (CI)[k_];
-#define RHOD_END_NEIGHBOURS                                                                        \
-  }                                                                                                \
+      const int k0 = (CS)[yy_ * (G).nx + x0_], k1 = (CS)[yy_ * (G).nx + x1_ + 1];
+#define RHOD_END_ROWS                                                                              \
   }                                                                                                \
   }
 

@@ -29,6 +29,8 @@ typedef double real;
   RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : var))
 #define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                                       \
   RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : v1, v2))
+/* On the device the particle loop is already the simd loop (one particle per lane). */
+#define RHOD_SIMD(...)
 #else
 #define RHOD_PRAGMA(x) _Pragma(#x)
 #define RHOD_KERNEL_LOOP RHOD_PRAGMA(omp parallel for schedule(static))
@@ -36,6 +38,16 @@ typedef double real;
   RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : var))
 #define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                                       \
   RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : v1, v2))
+/* RHOD_SIMD(clauses) vectorises a gather's inner loop over neighbours on the host
+ * (clauses: the reductions of its sums). Only where the CPU has masked vector loads
+ * (AVX2 and up, e.g. with -DRHOD_NATIVE=ON): without them the masked loop is slower
+ * than the scalar one, which skips the candidates outside the support (perf/RESULTS.md). */
+#define RHOD_PRAGMA_V(...) _Pragma(#__VA_ARGS__)
+#if defined(__AVX2__) && !defined(RHOD_NO_SIMD)
+#define RHOD_SIMD(...) RHOD_PRAGMA_V(omp simd __VA_ARGS__)
+#else
+#define RHOD_SIMD(...)
+#endif
 #endif
 
 #endif

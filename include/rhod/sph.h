@@ -35,6 +35,7 @@ typedef struct {
   real *drho, *acc, *vel; /* time derivatives: d rho/dt, du/dt (2), dx/dt (2) */
   uint8_t *fs;            /* 1: free-surface particle (set F) */
   uint8_t *reg;           /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
+  real *pk;               /* neighbour-side fields packed in cell order (rhod_sph.c) */
 } rhod_sph;
 
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p);
