@@ -32,7 +32,7 @@ enum {
   PK_P,
   PK_UX,
   PK_UY,
-  PK_DX, /* pass A */
+  PK_DX, /* the rows above: pass A's */
   PK_D,
   PK_GPX,
   PK_GPY,
@@ -42,7 +42,7 @@ enum {
   PK_GU3,
   PK_DUX,
   PK_DUY,
-  PK_RHO, /* pass C */
+  PK_RHO, /* from PK_D: pass C's */
   PK_ROWS
 };
 
@@ -308,14 +308,15 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const real *P = s->P, *V = s->V, *pk = s->pk;
   real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *gC = s->gC,
        *uch = s->uch, *lam = s->lam, *lapB = s->lapB;
-  const int kern = s->kernel, vcons = s->visc_cons;
+  const int kern = s->kernel, vcons = s->visc_cons, generic = s->generic;
   const real ratio = s->ratio;
+  (void)generic;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
 #ifdef RHOD_OFFLOAD
     pass_a_particle(i, PA_ARGS, kern);
 #else
-    if (kern == RHOD_KERNEL_WENDLAND_C2)
+    if (kern == RHOD_KERNEL_WENDLAND_C2 && !generic)
       pass_a_particle(i, PA_ARGS, RHOD_KERNEL_WENDLAND_C2);
     else
       pass_a_particle(i, PA_ARGS, kern);
@@ -725,8 +726,9 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   };
   const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
             shifting = s->shifting, visc = s->mu != 0;
-  const int sel =
-      kern != RHOD_KERNEL_WENDLAND_C2 ? -1 : 4 * (riemann + recon) + 2 * shifting + visc;
+  const int sel = (kern != RHOD_KERNEL_WENDLAND_C2 || s->generic)
+                      ? -1
+                      : 4 * (riemann + recon) + 2 * shifting + visc;
   (void)sel;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {

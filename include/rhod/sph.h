@@ -16,6 +16,8 @@ typedef struct {
   real cfl, cfl_visc;
   int riemann, recon, shifting, damper, fsdetect;
   int visc_cons; /* scheme.viscosity: consistent (and mu > 0) */
+  int generic;   /* 1: the general copies of the gathers, never the specialised ones
+                    (tests/test_kernels.c compares them) */
   real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
   /* per-particle fields (scratch, rebuilt each stage) */
   real *P, *V;
