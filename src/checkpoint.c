@@ -1,7 +1,8 @@
 /* Checkpoint writing and reading (checkpoint.h). Records in order:
  *   "RHODCKP1" u32 version u32 sizeof(real)
  *   f64 t next_out next_probe next_checkpoint checkpoint_every
- *   i64 step reflected   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
+ *   i64 step reflected splits merges (version 2; version 1 has no splits, merges)
+ *   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
  *   str scene_path   i32 nsets, str[nsets]   u32 nparams, (str key, str value)[nparams]
  *   u64 n next_id   i32 nfields, per field: str name, u64 elem, elem * n bytes
  *   u64 FNV-1a hash of all the bytes above
@@ -16,7 +17,7 @@
 #include <string.h>
 
 #define CK_MAGIC "RHODCKP1"
-#define CK_VERSION 1u
+#define CK_VERSION 2u           /* 2: the split and merge totals; version 1 is still read */
 #define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
 
 static uint64_t fnv1a(const unsigned char *b, size_t n) {
@@ -76,6 +77,8 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
   put_f64(&w, ck->checkpoint_every);
   put_i64(&w, ck->step);
   put_i64(&w, ck->reflected);
+  put_i64(&w, ck->splits);
+  put_i64(&w, ck->merges);
   put_u64(&w, ck->probes_bytes);
   put_i32(&w, ck->nsnap);
   put(&w, ck->snap_t, sizeof(double) * (size_t)ck->nsnap);
@@ -209,8 +212,8 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   get(r, &rsize, 4, "precision");
   if (r->bad)
     return read_fail(err, errlen, path, "truncated header");
-  if (version != CK_VERSION)
-    return read_fail(err, errlen, path, "checkpoint version %u, this rhod reads %u", version,
+  if (version != CK_VERSION && version != 1)
+    return read_fail(err, errlen, path, "checkpoint version %u, this rhod reads 1 to %u", version,
                      CK_VERSION);
   if (rsize != sizeof(real))
     return read_fail(err, errlen, path, "written by a %s-precision build, this one is %s",
@@ -222,6 +225,10 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   get(r, &ck->checkpoint_every, 8, "checkpoint interval");
   get(r, &ck->step, 8, "step");
   get(r, &ck->reflected, 8, "reflection count");
+  if (version >= 2) {
+    get(r, &ck->splits, 8, "split count");
+    get(r, &ck->merges, 8, "merge count");
+  }
   get(r, &ck->probes_bytes, 8, "probes.csv length");
   ck->nsnap = (int32_t)get_count(r, "snapshot count");
   ck->snap_t = get_array(r, (uint64_t)ck->nsnap, sizeof(double), "snapshot times");

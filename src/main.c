@@ -134,6 +134,8 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
   ck.checkpoint_every = c->ck_every;
   ck.step = c->sim.step;
   ck.reflected = c->sim.reflected;
+  ck.splits = c->sim.apr.split_total;
+  ck.merges = c->sim.apr.merged_total;
   long pos = c->csv.f ? ftell(c->csv.f) : -1;
   ck.probes_bytes = pos > 0 ? (uint64_t)pos : 0;
   ck.nsnap = c->nsnap;
@@ -339,6 +341,8 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       c.sim.t = ck.t;
       c.sim.step = ck.step;
       c.sim.reflected = ck.reflected;
+      c.sim.apr.split_total = ck.splits;
+      c.sim.apr.merged_total = ck.merges;
       c.sim.dt = rhod_sph_dt(&c.sim.sph, &c.sim.p); /* sizes may have been split since t = 0 */
       st = rhod_sim_prepare(&c.sim, 1);
       if (st != RHOD_OK)

@@ -59,6 +59,10 @@ cp -r "$T/e" "$T/f"
 rm -f "$T/f"/snapshot_0008.* "$T/f"/snapshot_0009.* "$T/f"/snapshot_0010.*
 expect 0 "APR: resume after a crash" -- "$RHOD" resume "$T/f"
 check "APR: resumed run identical to the uninterrupted one" -- same_outputs "$T/e" "$T/f"
+totals() { grep -E '"(splits|merges|wall_reflections)"' "$1/summary.json"; }
+check "APR: the run split particles" -- grep -q '"splits": [1-9]' "$T/e/summary.json"
+check "APR: split, merge and reflection totals carried over the restart" -- \
+  test "$(totals "$T/e")" = "$(totals "$T/f")"
 
 # 4. bad checkpoints: exit 10, one line naming the file and the reason
 cp -r "$T/a" "$T/d"

@@ -19,7 +19,8 @@ typedef struct {
   /* run state */
   double t, next_out, next_probe, next_checkpoint, checkpoint_every;
   int64_t step, reflected;
-  uint64_t probes_bytes; /* length of probes.csv when the checkpoint was taken */
+  int64_t splits, merges; /* APR totals of the run so far (0 from a version-1 file) */
+  uint64_t probes_bytes;  /* length of probes.csv when the checkpoint was taken */
   int32_t nsnap;
   double *snap_t;
   uint64_t *snap_n;
