@@ -43,7 +43,7 @@ typedef double real;
  * (AVX2 and up, e.g. with -DRHOD_NATIVE=ON): without them the masked loop is slower
  * than the scalar one, which skips the candidates outside the support (perf/RESULTS.md). */
 #define RHOD_PRAGMA_V(...) _Pragma(#__VA_ARGS__)
-#if defined(__AVX2__) && !defined(RHOD_NO_SIMD)
+#if defined(__AVX2__)
 #define RHOD_SIMD(...) RHOD_PRAGMA_V(omp simd __VA_ARGS__)
 #else
 #define RHOD_SIMD(...)
