@@ -19,6 +19,17 @@
 #define PARTICLE_BODY static inline __attribute__((always_inline))
 #endif
 
+/* The pair of i with the packed candidate k (RHOD_FOR_ROWS loops, xi, yi, R2 and the
+ * rows kx, ky in scope): declares rx, ry, r2, r, ir and n_ij = (nx, ny), or skips (continue)
+ * a candidate outside the support and one at r = 0: i itself, or a particle on top of i,
+ * which has no n_ij (docs/choices.md). */
+#define PAIR_OR_SKIP(k)                                                                            \
+  const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;                             \
+  if (!(r2 < R2 && r2 > 0))                                                                        \
+    continue;                                                                                      \
+  const real r = sqrt(r2), ir = 1 / r;                                                             \
+  const real nx = rx * ir, ny = ry * ir
+
 /* Rows of s->pk: the neighbour-side fields of the gathers, copied into the order of
  * the sorted cells (row r of particle CI[k] at pk[r * cap + k]), so that the inner
  * loops over a row of cells read them contiguously and vectorise (RHOD_FOR_ROWS).
@@ -186,12 +197,7 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
     RHOD_SIMD(reduction(+ : g, ggx, ggy, B0, B1, B2, B3, GPx, GPy, Gu0, Gu1, Gu2, Gu3, div, cx,
                         cy) reduction(max : um))
     for (int k = k0; k < k1; k++) {
-      const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
-      /* r = 0: i itself (see pass C) */
-      if (!(r2 < R2 && r2 > 0))
-        continue;
-      const real r = sqrt(r2), ir = 1 / r;
-      const real nx = rx * ir, ny = ry * ir;
+      PAIR_OR_SKIP(k);
       const real Vj = kV[k];
       const real q = r * iR;
       const real F = -rhod_dWq(kern, q) * iR3 * Vj; /* |grad_i W_ij| V_j */
@@ -249,11 +255,7 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
     RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
       RHOD_SIMD(reduction(+ : T40, T31, T22, T13, T04, Q30, Q21, Q12, Q03, P30, P21, P12, P03))
       for (int k = k0; k < k1; k++) {
-        const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
-        if (!(r2 < R2 && r2 > 0))
-          continue;
-        const real r = sqrt(r2), ir = 1 / r;
-        const real nx = rx * ir, ny = ry * ir;
+        PAIR_OR_SKIP(k);
         const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
         const real exx = nx * nx, exy = nx * ny, eyy = ny * ny, a = F * r, b = F * r2;
         T40 += a * exx * exx, T31 += a * exx * exy, T22 += a * exx * eyy;
@@ -601,12 +603,7 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
     RHOD_SIMD(reduction(+ : vRx, vRy, vCx, vCy, sfx, sfy, cont, vsx, vsy, ddu, drdu, ruux, ruuy))
     for (int k = k0; k < k1; k++) {
-      const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
-      /* r = 0: i itself (a particle on top of another would have no n_ij either) */
-      if (!(r2 < R2 && r2 > 0))
-        continue;
-      const real r = sqrt(r2), ir = 1 / r;
-      const real nx = rx * ir, ny = ry * ir;
+      PAIR_OR_SKIP(k);
       const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k]; /* |grad_i W_ij| V_j */
       const real fx = F * nx, fy = F * ny;
       const real Pj = kP[k], uxj = kux[k], uyj = kuy[k];
