@@ -134,6 +134,7 @@ typedef struct {
   y_probe_front *front;
   y_probe_sum *mass, *momentum;
   y_probe_angular *angular_momentum;
+  y_probe_sum *elastic_energy;
 } y_probe;
 
 typedef struct {
@@ -247,8 +248,9 @@ static const cyaml_strval_t pattern_names[] = {
 };
 static const char *const probe_kind_names[] = {
     "pressure", "kinetic_energy", "potential_energy", "front",
-    "mass",     "momentum",       "angular_momentum",
+    "mass",     "momentum",       "angular_momentum", "elastic_energy",
 };
+#define N_PROBE_KINDS 8
 
 static const cyaml_schema_field_t f_time[] = {
     NUM("end", y_time, end),
@@ -382,6 +384,7 @@ static const cyaml_schema_field_t f_probe[] = {
     PROBE("mass", mass, f_probe_sum),
     PROBE("momentum", momentum, f_probe_sum),
     PROBE("angular_momentum", angular_momentum, f_probe_angular),
+    PROBE("elastic_energy", elastic_energy, f_probe_sum),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_probe = {
@@ -1157,10 +1160,11 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
                       size_t kpl) {
   char base[64];
   snprintf(base, sizeof base, "probes.list.%u", i);
-  const void *given[7] = {y->pressure, y->kinetic_energy, y->potential_energy, y->front,
-                          y->mass,     y->momentum,       y->angular_momentum};
+  const void *given[N_PROBE_KINDS] = {
+      y->pressure, y->kinetic_energy, y->potential_energy, y->front,
+      y->mass,     y->momentum,       y->angular_momentum, y->elastic_energy};
   int first = -1;
-  for (int k = 0; k < 7; k++) {
+  for (int k = 0; k < N_PROBE_KINDS; k++) {
     if (!given[k])
       continue;
     if (first >= 0) {
@@ -1172,7 +1176,7 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
   }
   if (first < 0) {
     char kinds[256] = "";
-    for (int k = 0; k < 7; k++)
+    for (int k = 0; k < N_PROBE_KINDS; k++)
       snprintf(kinds + strlen(kinds), sizeof kinds - strlen(kinds), "%s%s", k ? ", " : "",
                probe_kind_names[k]);
     return fail(c, base, "needs a probe kind: one of %s", kinds);
@@ -1216,6 +1220,9 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
     name = y->angular_momentum->name;
     if (y->angular_momentum->at)
       memcpy(p->at, y->angular_momentum->at, sizeof p->at);
+    break;
+  case RHOD_PROBE_ELASTIC_ENERGY:
+    name = y->elastic_energy->name;
     break;
   }
   if (!name)

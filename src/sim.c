@@ -628,6 +628,29 @@ void rhod_probe_values(rhod_sim *s, double *values) {
       values[k++] = b;
       break;
     }
+    case RHOD_PROBE_ELASTIC_ENERGY: {
+      /* The energy stored by compression: with the linear state law of paper 002
+       * Eq. 2, P = c0^2 (rho - rho0), the work per unit mass
+       * e = int_rho0^rho P / r^2 dr = c0^2 (ln(rho/rho0) + rho0/rho - 1), or with
+       * q = 1 - rho0/rho, e = c0^2 (-ln(1 - q) - q) = c0^2 (q^2/2 + q^3/3 + ...). The
+       * series (to q^5, relative error below q^4/3) where |q| < 0.01 avoids the
+       * cancellation of the closed form in single precision. Conservative SPH without
+       * the diffusive terms conserves E_k + E_e (tests). */
+      const real c2 = h->c0 * h->c0, rho0 = h->rho0;
+      const real *rho = p->rho;
+      real e = 0;
+      RHOD_KERNEL_LOOP_REDUCE(+, e)
+      for (long j = 0; j < n; j++) {
+        const real q = 1 - rho0 / rho[j];
+        const real f =
+            fabs(q) < (real)0.01
+                ? q * q * ((real)0.5 + q * ((real)1 / 3 + q * ((real)0.25 + q * (real)0.2)))
+                : -log1p(-q) - q;
+        e += m[j] * c2 * f;
+      }
+      values[k++] = e;
+      break;
+    }
     case RHOD_PROBE_ANGULAR_MOMENTUM: {
       real a = 0;
       RHOD_KERNEL_LOOP_REDUCE(+, a)

@@ -68,7 +68,8 @@ typedef enum {
   RHOD_PROBE_FRONT,            /* max over fluid of x.direction [m] */
   RHOD_PROBE_MASS,             /* sum m [kg/m] */
   RHOD_PROBE_MOMENTUM,         /* sum m u, two columns name_x, name_y [kg/s] */
-  RHOD_PROBE_ANGULAR_MOMENTUM  /* sum m (x - at) x u [kg m/s] */
+  RHOD_PROBE_ANGULAR_MOMENTUM, /* sum m (x - at) x u [kg m/s] */
+  RHOD_PROBE_ELASTIC_ENERGY    /* sum m e(rho), e the compression energy of Eq. 2 [J/m] */
 } rhod_probe_kind;
 
 typedef struct {
