@@ -99,10 +99,11 @@ int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], doubl
   c->g.inv = (real)(1.0 / cw);
   c->g.reach = reach;
   c->g.iR0 = (real)(1.0 / radius);
-  c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
-  map_alloc(&c->start, c->ncells + 1);
-  map_alloc(&c->count, c->ncells + 1);
-  c->mark = rhod_dev_calloc(c->ncells, 1);
+  c->nx_box = c->g.nx, c->ny_box = c->g.ny; /* the window starts as the whole box */
+  c->ncells_box = c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
+  map_alloc(&c->start, c->ncells_box + 1);
+  map_alloc(&c->count, c->ncells_box + 1);
+  c->mark = rhod_dev_calloc(c->ncells_box, 1);
   if (!c->start || !c->count || !c->mark)
     return RHOD_ERR_MEMORY;
   return rhod_cells_reserve(c, cap);
@@ -120,18 +121,44 @@ int rhod_cells_reserve(rhod_cells *c, size_t cap) {
 }
 
 void rhod_cells_free(rhod_cells *c) {
-  map_free(&c->start, c->ncells + 1);
-  map_free(&c->count, c->ncells + 1);
-  rhod_dev_free(c->mark, c->ncells);
+  map_free(&c->start, c->ncells_box + 1);
+  map_free(&c->count, c->ncells_box + 1);
+  rhod_dev_free(c->mark, c->ncells_box);
   c->mark = NULL;
   map_free(&c->idx, c->cap);
   map_free(&c->key, c->cap);
 }
 
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count) {
-  const rhod_grid G = c->g;
   int32_t *key = c->key, *cnt = c->count, *start = c->start, *idx = c->idx;
-  const long n = (long)count, nc = (long)c->ncells;
+  const long n = (long)count;
+  /* the window: the lowest and highest occupied cells of the box's lattice */
+  {
+    const real ox = c->g.ox, oy = c->g.oy, inv = c->g.inv;
+    const int bx = c->nx_box, by = c->ny_box;
+    int lx = bx - 1, ly = by - 1, hx = 0, hy = 0;
+    RHOD_KERNEL_LOOP_REDUCE2(min, lx, ly)
+    for (long i = 0; i < n; i++) {
+      const int cx = rhod_cell_coord(x[i], ox, inv, 0, bx),
+                cy = rhod_cell_coord(y[i], oy, inv, 0, by);
+      lx = cx < lx ? cx : lx;
+      ly = cy < ly ? cy : ly;
+    }
+    RHOD_KERNEL_LOOP_REDUCE2(max, hx, hy)
+    for (long i = 0; i < n; i++) {
+      const int cx = rhod_cell_coord(x[i], ox, inv, 0, bx),
+                cy = rhod_cell_coord(y[i], oy, inv, 0, by);
+      hx = cx > hx ? cx : hx;
+      hy = cy > hy ? cy : hy;
+    }
+    if (n == 0)
+      lx = ly = hx = hy = 0;
+    c->g.cx0 = lx, c->g.cy0 = ly;
+    c->g.nx = hx - lx + 1, c->g.ny = hy - ly + 1;
+    c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
+  }
+  const rhod_grid G = c->g;
+  const long nc = (long)c->ncells;
 
   RHOD_KERNEL_LOOP
   for (long k = 0; k <= nc; k++)
@@ -139,8 +166,8 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
 
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
-    const int cx = rhod_cell_coord(x[i], G.ox, G.inv, G.nx);
-    const int cy = rhod_cell_coord(y[i], G.oy, G.inv, G.ny);
+    const int cx = rhod_cell_coord(x[i], G.ox, G.inv, G.cx0, G.nx);
+    const int cy = rhod_cell_coord(y[i], G.oy, G.inv, G.cy0, G.ny);
     const int k = cy * G.nx + cx;
     key[i] = k;
 #pragma omp atomic update

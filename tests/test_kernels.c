@@ -136,6 +136,54 @@ static void test_neighbours_brute_force(void) {
   }
 }
 
+/* A cloud in a box 50 times its size: each build keeps only the window of occupied
+ * cells, and a query anywhere (inside the window, or outside it within a radius of
+ * the cloud, where it is clamped into the window) finds what brute force finds. */
+static void test_cells_window(void) {
+  cloud cl;
+  cloud_make(&cl, 37, 23, 0.01, 0.9, 5);
+  rhod_cells_free(&cl.c);
+  const double lo[2] = {-10, -6}, hi[2] = {12, 9}, R0 = 0.04;
+  CU_ASSERT_EQUAL_FATAL(rhod_cells_init(&cl.c, lo, hi, R0, RHOD_CELL_REACH, cl.p.cap), RHOD_OK);
+  cloud_sync(&cl);
+  rhod_particles *p = &cl.p;
+  rhod_cells_build(&cl.c, p->x, p->y, p->n);
+  /* the cloud spans about 0.38 x 0.24 m, cells are 0.02 m: 20 x 13 cells, plus a
+   * border cell for the jitter */
+  CU_ASSERT(cl.c.g.nx <= 22 && cl.c.g.ny <= 15);
+  CU_ASSERT(cl.c.ncells * 1000 < cl.c.ncells_box);
+  rhod_to_host(cl.c.start, (cl.c.ncells + 1) * sizeof(int32_t));
+  rhod_to_host(cl.c.idx, p->n * sizeof(int32_t));
+  CU_ASSERT_EQUAL(cl.c.start[cl.c.ncells], (int32_t)p->n);
+  const rhod_grid G = cl.c.g;
+  const int32_t *CS = cl.c.start, *CI = cl.c.idx;
+  const real R = (real)R0;
+  long mism = 0, total = 0;
+  for (int q = 0; q < (int)p->n + 40; q++) {
+    /* the particles, then points around the cloud, inside and outside the window */
+    const real a = (real)(6.2831853 * (q - (int)p->n) / 40.0);
+    const real qx = q < (int)p->n ? p->x[q] : (real)(0.185 + 0.215 * cos(a));
+    const real qy = q < (int)p->n ? p->y[q] : (real)(0.115 + 0.145 * sin(a));
+    int found = 0, brute = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, qx, qy, R, j) {
+      const real rx = p->x[j] - qx, ry = p->y[j] - qy;
+      if (rx * rx + ry * ry < R * R)
+        found++;
+    }
+    RHOD_END_NEIGHBOURS
+    for (size_t j = 0; j < p->n; j++) {
+      const real rx = p->x[j] - qx, ry = p->y[j] - qy;
+      if (rx * rx + ry * ry < R * R)
+        brute++;
+    }
+    mism += found != brute;
+    total += brute;
+  }
+  CU_ASSERT_EQUAL(mism, 0);
+  CU_ASSERT(total > 30 * (long)p->n);
+  cloud_free(&cl);
+}
+
 static void test_sort_determinism(void) {
   /* the same cloud sorted twice (and with different thread counts) gives the same order */
   int32_t *first = NULL;
@@ -518,6 +566,7 @@ int main(void) {
   const rhod_test_case cases[] = {
       {"kernel normalisation and gradient", test_kernel_normalisation},
       {"neighbour search against brute force", test_neighbours_brute_force},
+      {"cells: a window of occupied cells in a large box", test_cells_window},
       {"sort determinism", test_sort_determinism},
       {"renormalised gradient exact for linear fields", test_renormalised_gradient_linear},
       {"free-surface detection on a square", test_free_surface_square},

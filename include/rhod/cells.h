@@ -9,7 +9,12 @@
  * a wider scan is one range per row plus the particles in it (perf/bench_mixed
  * compares this with a grid made for the coarsest radius). Order inside a cell is by
  * particle index, so every sum is taken in the same order run after run
- * (bit-reproducible). */
+ * (bit-reproducible).
+ *
+ * Each build sizes the grid to the particles: the cells are those of a fixed lattice
+ * over the box, but only the window from the lowest to the highest occupied cell is
+ * counted, scanned and kept, so a scene whose box is mostly empty (a patch in a large
+ * domain) does not pay for the empty cells. */
 #ifndef RHOD_CELLS_H
 #define RHOD_CELLS_H
 
@@ -24,21 +29,24 @@
 
 /* Grid geometry, plain values: safe to pass by value into device regions. */
 typedef struct {
-  real ox, oy; /* lower-left corner */
-  real inv;    /* 1 / cell */
-  int nx, ny;
-  int reach; /* cells scanned on each side by a particle of radius R0 */
-  real iR0;  /* 1 / R0 */
+  real ox, oy;  /* lower-left corner of the box's lattice */
+  real inv;     /* 1 / cell */
+  real iR0;     /* 1 / R0 */
+  int nx, ny;   /* the window's size in cells (set by each build) */
+  int cx0, cy0; /* the window's first cell, in lattice coordinates */
+  int reach;    /* cells scanned on each side by a particle of radius R0 */
 } rhod_grid;
 
 typedef struct {
   rhod_grid g;
-  size_t ncells;
-  int32_t *start; /* ncells + 1: particles of cell c are idx[start[c] .. start[c+1]) */
-  int32_t *count; /* ncells: histogram scratch */
-  int32_t *idx;   /* cap: particle indices sorted by cell */
-  int32_t *key;   /* cap: cell of each particle */
-  uint8_t *mark;  /* ncells: per-cell flag (rhod_cells_mark) */
+  size_t ncells;      /* cells of the window: g.nx * g.ny */
+  int nx_box, ny_box; /* the lattice over the whole box */
+  size_t ncells_box;  /* allocated: nx_box * ny_box */
+  int32_t *start;     /* ncells + 1: particles of cell c are idx[start[c] .. start[c+1]) */
+  int32_t *count;     /* ncells: histogram scratch */
+  int32_t *idx;       /* cap: particle indices sorted by cell */
+  int32_t *key;       /* cap: cell of each particle */
+  uint8_t *mark;      /* ncells: per-cell flag (rhod_cells_mark) */
   size_t cap;
 } rhod_cells;
 
@@ -48,8 +56,10 @@ int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], doubl
                     size_t cap);
 int rhod_cells_reserve(rhod_cells *c, size_t cap);
 void rhod_cells_free(rhod_cells *c);
-/* Sorts particles [0, count) into the cells (positions on the device). Particles
- * outside the grid are clamped into the border cells. */
+/* Sorts particles [0, count) into the cells (positions on the device), the window
+ * spanning their cells. Particles outside the box are clamped into its border cells;
+ * a later query outside the window is clamped into the window's border cells, which
+ * still scans every particle within reach of it. */
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count);
 
 /* mark[c] = 1 when some particle of cell c has flag != 0 (flags of the particles
@@ -57,9 +67,10 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
  * particle in reach (rhod_cells_near_mark). */
 void rhod_cells_mark(rhod_cells *c, const uint8_t *flag);
 
-/* Cell coordinate of a position along one axis, clamped to the grid. */
-static inline int rhod_cell_coord(real v, real o, real inv, int n) {
-  int k = (int)((v - o) * inv);
+/* Cell coordinate of a position along one axis in the window [off, off + n) of the
+ * lattice with origin o, relative to the window, clamped to it. */
+static inline int rhod_cell_coord(real v, real o, real inv, int off, int n) {
+  int k = (int)((v - o) * inv) - off;
   return k < 0 ? 0 : (k >= n ? n - 1 : k);
 }
 
@@ -102,8 +113,8 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
 #define RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1)                                                   \
   {                                                                                                \
     const int rc_ = rhod_cell_reach((G), (Ri));                                                    \
-    const int cx_ = rhod_cell_coord((xi), (G).ox, (G).inv, (G).nx);                                \
-    const int cy_ = rhod_cell_coord((yi), (G).oy, (G).inv, (G).ny);                                \
+    const int cx_ = rhod_cell_coord((xi), (G).ox, (G).inv, (G).cx0, (G).nx);                       \
+    const int cy_ = rhod_cell_coord((yi), (G).oy, (G).inv, (G).cy0, (G).ny);                       \
     const int y0_ = cy_ - rc_ > 0 ? cy_ - rc_ : 0;                                                 \
     const int y1_ = cy_ + rc_ < (G).ny - 1 ? cy_ + rc_ : (G).ny - 1;                               \
     const int x0_ = cx_ - rc_ > 0 ? cx_ - rc_ : 0;                                                 \
@@ -116,19 +127,25 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
 
 /* 1 when a cell within reach of a support of radius R at (x, y) is marked (inside
  * device regions: pass a local copy of c->mark). */
-static inline int rhod_cells_near_mark(rhod_grid G, const uint8_t *mark, real x, real y, real R) {
-  const int rc = rhod_cell_reach(G, R);
-  const int cx = rhod_cell_coord(x, G.ox, G.inv, G.nx), cy = rhod_cell_coord(y, G.oy, G.inv, G.ny);
+static inline int rhod_cells_near_mark_(const uint8_t *mark, real ox, real oy, real inv, int cx0,
+                                        int cy0, int nx, int ny, int rc, real x, real y) {
+  const int cx = rhod_cell_coord(x, ox, inv, cx0, nx);
+  const int cy = rhod_cell_coord(y, oy, inv, cy0, ny);
   const int y0 = cy - rc > 0 ? cy - rc : 0;
-  const int y1 = cy + rc < G.ny - 1 ? cy + rc : G.ny - 1;
+  const int y1 = cy + rc < ny - 1 ? cy + rc : ny - 1;
   const int x0 = cx - rc > 0 ? cx - rc : 0;
-  const int x1 = cx + rc < G.nx - 1 ? cx + rc : G.nx - 1;
+  const int x1 = cx + rc < nx - 1 ? cx + rc : nx - 1;
   for (int yy = y0; yy <= y1; yy++)
     for (int xx = x0; xx <= x1; xx++)
-      if (mark[yy * G.nx + xx])
+      if (mark[yy * nx + xx])
         return 1;
   return 0;
 }
+/* (the grid's fields are passed one by one: GCC 12's nvptx offload compiler fails with
+ * an internal error on this struct passed by value to an inline function here) */
+#define rhod_cells_near_mark(G, mark, x, y, R)                                                     \
+  rhod_cells_near_mark_((mark), (G).ox, (G).oy, (G).inv, (G).cx0, (G).cy0, (G).nx, (G).ny,         \
+                        rhod_cell_reach((G), (R)), (x), (y))
 
 /* Exclusive prefix sum of n ints in place on the device; returns the total. */
 long rhod_scan_exclusive(int32_t *a, size_t n);
