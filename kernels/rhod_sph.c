@@ -73,6 +73,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   s->shifting = sc->shifting;
   s->damper = sc->acoustic_damper;
   s->fsdetect = sc->free_surface;
+  s->tic = sc->tensile_control;
   s->alpha_ad = (real)sc->alpha_ad;
   s->sa = (real)sc->shift_a;
   s->sb = (real)sc->shift_b;
@@ -563,7 +564,7 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
  * particles, and a branch on a switch is uniform across them). */
 typedef struct {
   real ratio, c0, rho0, ic2, gx, gy, alpha_ad, gth, tth, visc_k, mu;
-  int vcons;
+  int vcons, tic;
 } pass_c_consts;
 
 #define PC_PARAMS                                                                                  \
@@ -676,8 +677,14 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   /* renormalised part: L^T (vR - renP P_i sf) */
   const real wx = vRx - renP * Pi * sfx, wy = vRy - renP * Pi * sfy;
   /* plain part: vC + ((1 - renP) P_i - kAD D_i) sf, i.e. sum (P_j + P_i) gW V for a
-   * conservative Eq. 6, and -F^AD of Eq. 9 */
-  const real ki = (1 - renP) * Pi - kAD * Di;
+   * conservative Eq. 6, and -F^AD of Eq. 9. With scheme.tensile_control, where
+   * P_i < 0 the conservative sum is sum (P_j - P_i) gW V instead: the tensile-
+   * instability switch of Sun et al. 2018 as paper 001 writes it (Eq. 5; paper 000
+   * Eq. 2, p_j +- p_i), applied here only where Eq. 6 is conservative, i.e. in the
+   * free-surface region and where Gamma_i < 0.85 (our choice, docs/choices.md): the
+   * renormalised form of the bulk avoids the tensile instability (paper 002 Sec. IV, item iv). */
+  const real Pc = (K.tic && Pi < 0) ? -Pi : Pi;
+  const real ki = (1 - renP) * Pc - kAD * Di;
   real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * K.gx + vsx;
   real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * K.gy + vsy;
   /* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
@@ -731,6 +738,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       .visc_k = 2 * (RHOD_DIM + 2) * s->mu, /* Eq. 10 */
       .mu = s->mu,
       .vcons = s->visc_cons,
+      .tic = s->tic,
   };
   const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
             shifting = s->shifting, visc = s->mu != 0;

@@ -98,6 +98,7 @@ typedef struct {
   double *shifting_a, *shifting_b, *shifting_eps;
   bool *acoustic_damper;
   double *alpha_ad;
+  bool *tensile_control;
   bool *free_surface;
   double *free_surface_lambda;
   double *shepard_threshold, *theta_threshold;
@@ -283,6 +284,7 @@ static const cyaml_schema_field_t f_scheme[] = {
     NUM_OPT("shifting_eps", y_scheme, shifting_eps),
     BOOL_OPT("acoustic_damper", y_scheme, acoustic_damper),
     NUM_OPT("alpha_ad", y_scheme, alpha_ad),
+    BOOL_OPT("tensile_control", y_scheme, tensile_control),
     BOOL_OPT("free_surface", y_scheme, free_surface),
     VEC("free_surface_lambda", OPT, y_scheme, free_surface_lambda),
     NUM_OPT("shepard_threshold", y_scheme, shepard_threshold),
@@ -1353,6 +1355,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->shift_eps = opt(sc->shifting_eps, 5e-4);
   s->acoustic_damper = opt_bool(sc->acoustic_damper, 1);
   s->alpha_ad = opt(sc->alpha_ad, 1);
+  s->tensile_control = opt_bool(sc->tensile_control, 0);
   s->free_surface = opt_bool(sc->free_surface, 1);
   s->fs_lambda_low = sc->free_surface_lambda ? sc->free_surface_lambda[0] : 0.2;
   s->fs_lambda_high = sc->free_surface_lambda ? sc->free_surface_lambda[1] : 0.75;
@@ -1706,6 +1709,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "shifting_eps", s->shift_eps);
   tb_bool(&t, m, "acoustic_damper", s->acoustic_damper);
   tb_num(&t, m, "alpha_ad", s->alpha_ad);
+  tb_bool(&t, m, "tensile_control", s->tensile_control);
   tb_bool(&t, m, "free_surface", s->free_surface);
   double lambda[2] = {s->fs_lambda_low, s->fs_lambda_high};
   tb_vec(&t, m, "free_surface_lambda", lambda);

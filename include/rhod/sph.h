@@ -15,6 +15,7 @@ typedef struct {
   real rho0, c0, mu, gx, gy;
   real cfl, cfl_visc;
   int riemann, recon, shifting, damper, fsdetect;
+  int tic;       /* scheme.tensile_control */
   int visc_cons; /* scheme.viscosity: consistent (and mu > 0) */
   int generic;   /* 1: the general copies of the gathers, never the specialised ones
                     (tests/test_kernels.c compares them) */
