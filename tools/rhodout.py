@@ -3,9 +3,12 @@
 Used by the cases' check and study scripts. Needs Debian's python3-numpy and
 python3-h5py (installed by scripts/setup.sh)."""
 import csv
+import datetime
 import glob
 import json
 import os
+import platform
+import subprocess
 
 import h5py
 import numpy as np
@@ -70,3 +73,28 @@ def refdata(path):
     head = lines[0].strip().split(",")
     data = np.array([[float(v) for v in l.strip().split(",")] for l in lines[1:]])
     return {h: data[:, k] for k, h in enumerate(head)}
+
+
+def machine():
+    """The host as results files name it: name, cores, CPU model and its widest vector
+    extension (timings differ between the AVX2 and AVX-512 machines of the same kind)."""
+    model, flags = "unknown CPU", set()
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name") and model == "unknown CPU":
+                    model = line.split(":", 1)[1].strip()
+                elif line.startswith("flags") and not flags:
+                    flags = set(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE2"
+    return f"{platform.node()} ({os.cpu_count()} cores, {model}, {simd})"
+
+
+def stamp(command):
+    """'Date D, commit C, machine M, command `command`' for a results file's header."""
+    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+    commit = subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip()
+    return f"Date {datetime.date.today()}, commit {commit}, machine {machine()}, command `{command}`"
