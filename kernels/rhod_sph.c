@@ -680,10 +680,13 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
    * conservative Eq. 6, and -F^AD of Eq. 9. With scheme.tensile_control, where
    * P_i < 0 the conservative sum is sum (P_j - P_i) gW V instead: the tensile-
    * instability switch of Sun et al. 2018 as paper 001 writes it (Eq. 5; paper 000
-   * Eq. 2, p_j +- p_i), applied here only where Eq. 6 is conservative, i.e. in the
-   * free-surface region and where Gamma_i < 0.85 (our choice, docs/choices.md): the
-   * renormalised form of the bulk avoids the tensile instability (paper 002 Sec. IV, item iv). */
-  const real Pc = (K.tic && Pi < 0) ? -Pi : Pi;
+   * Eq. 2, p_j +- p_i). Our choice (docs/choices.md): only where Eq. 6 is conservative
+   * (the renormalised bulk form avoids the tensile instability, paper 002 Sec. IV,
+   * item iv) and i is not itself a free-surface particle: with a truncated support the
+   * minus form loses the dynamic free-surface condition (paper 000 Sec. 2.1 asks for a
+   * free-surface detection to exclude it; applied on F too, the dam break at H/dx = 50
+   * blew up within 93 steps). */
+  const real Pc = (K.tic && Pi < 0 && reg[i] != 2) ? -Pi : Pi;
   const real ki = (1 - renP) * Pc - kAD * Di;
   real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * K.gx + vsx;
   real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * K.gy + vsy;

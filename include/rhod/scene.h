@@ -159,7 +159,8 @@ typedef struct {
   int acoustic_damper;                /* scheme.acoustic_damper: Eq. 9 */
   double alpha_ad;                    /* scheme.alpha_ad: 1 */
   int tensile_control;                /* scheme.tensile_control: P_j - P_i in the conservative
-                                        Eq. 6 where P_i < 0 (paper 001 Eq. 5); default off */
+                                        Eq. 6 where P_i < 0, off the free surface (paper 001
+                                        Eq. 5); default off */
   int free_surface; /* scheme.free_surface: detection of Ref. 51 and the Eq. 6 switch;
                        off: every particle is inner */
   double fs_lambda_low, fs_lambda_high; /* scheme.free_surface_lambda: [0.2, 0.75] */
