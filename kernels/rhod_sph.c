@@ -564,8 +564,10 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
  * particles, and a branch on a switch is uniform across them). */
 typedef struct {
   real ratio, c0, rho0, ic2, gx, gy, alpha_ad, gth, tth, visc_k, mu;
-  int vcons, tic;
+  int flags; /* PC_VCONS | PC_TIC: one int, since with two GCC 12 nvptx put the struct in a
+                lane-shared frame (tests/offload_frames.sh) */
 } pass_c_consts;
+enum { PC_VCONS = 1, PC_TIC = 2 }; /* the consistent Laplacian; scheme.tensile_control */
 
 #define PC_PARAMS                                                                                  \
   rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
@@ -604,7 +606,7 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   /* the consistent Laplacian where the pressure gradient is renormalised and B^ was
    * solved (pass A), with mu folded in; elsewhere Eq. 10 (weight e10) */
   real bxx = 0, bxy = 0, byy = 0;
-  if (visc && K.vcons && renP != 0)
+  if (visc && (K.flags & PC_VCONS) && renP != 0)
     bxx = K.mu * lapB[3 * i], bxy = K.mu * lapB[3 * i + 1], byy = K.mu * lapB[3 * i + 2];
   const real e10 = (bxx + byy != 0) ? 0 : K.visc_k;
   const real kAD = K.alpha_ad * rho0 * c0 * (real)0.5 * Ri; /* Eq. 9, h_i = R_i/2 */
@@ -686,7 +688,7 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
    * minus form loses the dynamic free-surface condition (paper 000 Sec. 2.1 asks for a
    * free-surface detection to exclude it; applied on F too, the dam break at H/dx = 50
    * blew up within 93 steps). */
-  const real Pc = (K.tic && Pi < 0 && reg[i] != 2) ? -Pi : Pi;
+  const real Pc = ((K.flags & PC_TIC) && Pi < 0 && reg[i] != 2) ? -Pi : Pi;
   const real ki = (1 - renP) * Pc - kAD * Di;
   real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * K.gx + vsx;
   real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * K.gy + vsy;
@@ -740,8 +742,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       .tth = s->theta_th,
       .visc_k = 2 * (RHOD_DIM + 2) * s->mu, /* Eq. 10 */
       .mu = s->mu,
-      .vcons = s->visc_cons,
-      .tic = s->tic,
+      .flags = (s->visc_cons ? PC_VCONS : 0) | (s->tic ? PC_TIC : 0),
   };
   const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
             shifting = s->shifting, visc = s->mu != 0;
