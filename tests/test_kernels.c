@@ -95,6 +95,14 @@ static void cloud_make(cloud *cl, int nx, int ny, double dx, double jitter, unsi
 
 static void cloud_sync(cloud *cl) { rhod_particles_to_device(&cl->p); }
 
+/* One right-hand side of the scheme on the cloud as it is (host values copied over). */
+static void cloud_rhs(cloud *cl) {
+  cloud_sync(cl);
+  rhod_sph_fill_state(&cl->s, &cl->p);
+  rhod_cells_build(&cl->c, cl->p.x, cl->p.y, cl->p.n);
+  rhod_sph_rhs(&cl->s, &cl->p, &cl->c, (real)1e-4);
+}
+
 static void cloud_free(cloud *cl) {
   rhod_cells_free(&cl->c);
   rhod_particles_free(&cl->p);
@@ -230,10 +238,7 @@ static void test_renormalised_gradient_linear(void) {
     p->ux[i] = (real)(2 * p->x[i] - p->y[i]);
     p->uy[i] = (real)(3 * p->y[i] + p->x[i]);
   }
-  cloud_sync(&cl);
-  rhod_sph_fill_state(s, p);
-  rhod_cells_build(&cl.c, p->x, p->y, p->n);
-  rhod_sph_rhs(s, p, &cl.c, (real)1e-4);
+  cloud_rhs(&cl);
   rhod_to_host(s->gP, 2 * p->n * sizeof(real));
   rhod_to_host(s->gu, 4 * p->n * sizeof(real));
   rhod_to_host(s->ggam, 2 * p->n * sizeof(real));
@@ -282,10 +287,7 @@ static double viscous_error(void (*edit)(rhod_scene *), int *count) {
     p->ux[i] = (real)(x * x - 2 * x * y + 3 * y * y);
     p->uy[i] = (real)(-x * x - 2 * x * y + y * y);
   }
-  cloud_sync(&cl);
-  rhod_sph_fill_state(&cl.s, p);
-  rhod_cells_build(&cl.c, p->x, p->y, p->n);
-  rhod_sph_rhs(&cl.s, p, &cl.c, (real)1e-4);
+  cloud_rhs(&cl);
   rhod_to_host(cl.s.acc, 2 * p->n * sizeof(real));
   rhod_to_host(cl.s.gam, p->n * sizeof(real));
   const double ax = 8.0 / 1000; /* mu lap u_x / rho0 */
@@ -338,10 +340,7 @@ static void rhs_with(int combo, int generic, double *out, size_t *n_out) {
     p->ux[i] = (real)(0.3 * sin(20 * y) + 0.1 * x);
     p->uy[i] = (real)(-0.2 * cos(25 * x) + 0.05 * y * y);
   }
-  cloud_sync(&cl);
-  rhod_sph_fill_state(s, p);
-  rhod_cells_build(&cl.c, p->x, p->y, p->n);
-  rhod_sph_rhs(s, p, &cl.c, (real)1e-4);
+  cloud_rhs(&cl);
   rhod_to_host(s->drho, p->n * sizeof(real));
   rhod_to_host(s->acc, 2 * p->n * sizeof(real));
   for (size_t i = 0; i < p->n; i++) {
@@ -394,10 +393,7 @@ static void tic_rhs(int tic, int full, double (*rho_of)(double, double), double 
     s->riemann = s->recon = s->shifting = s->damper = 0;
   for (size_t i = 0; i < p->n; i++)
     p->rho[i] = (real)(rho_of ? rho_of(p->x[i], p->y[i]) : 999.75);
-  cloud_sync(&cl);
-  rhod_sph_fill_state(s, p);
-  rhod_cells_build(&cl.c, p->x, p->y, p->n);
-  rhod_sph_rhs(s, p, &cl.c, (real)1e-4);
+  cloud_rhs(&cl);
   rhod_to_host(s->acc, 2 * p->n * sizeof(real));
   rhod_to_host(s->P, p->n * sizeof(real));
   rhod_to_host(s->reg, p->n);
@@ -477,10 +473,7 @@ static void test_coincident_pair(void) {
   const size_t d = p->n++, src = 5 * 12 + 6; /* a copy of an inner particle */
   p->x[d] = p->x[src], p->y[d] = p->y[src], p->ux[d] = 0.1, p->uy[d] = 0;
   p->rho[d] = 1000, p->m[d] = p->m[src], p->dx[d] = p->dx[src], p->id[d] = d;
-  cloud_sync(&cl);
-  rhod_sph_fill_state(&cl.s, p);
-  rhod_cells_build(&cl.c, p->x, p->y, p->n);
-  rhod_sph_rhs(&cl.s, p, &cl.c, (real)1e-4);
+  cloud_rhs(&cl);
   rhod_to_host(cl.s.drho, p->n * sizeof(real));
   rhod_to_host(cl.s.acc, 2 * p->n * sizeof(real));
   int finite = 1;
@@ -496,10 +489,7 @@ static void test_free_surface_square(void) {
   const int N = 24;
   cloud_make(&cl, N, N, 0.01, 0.0, 1);
   rhod_particles *p = &cl.p;
-  cloud_sync(&cl);
-  rhod_sph_fill_state(&cl.s, p);
-  rhod_cells_build(&cl.c, p->x, p->y, p->n);
-  rhod_sph_rhs(&cl.s, p, &cl.c, (real)1e-4);
+  cloud_rhs(&cl);
   rhod_to_host(cl.s.fs, p->n);
   rhod_to_host(cl.s.reg, p->n);
   rhod_to_host(cl.s.gam, p->n * sizeof(real));
