@@ -74,6 +74,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   s->damper = sc->acoustic_damper;
   s->fsdetect = sc->free_surface;
   s->tic = sc->tensile_control;
+  s->shsw = sc->shifting_switch;
   s->alpha_ad = (real)sc->alpha_ad;
   s->sa = (real)sc->shift_a;
   s->sb = (real)sc->shift_b;
@@ -564,10 +565,11 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
  * particles, and a branch on a switch is uniform across them). */
 typedef struct {
   real ratio, c0, rho0, ic2, gx, gy, alpha_ad, gth, tth, visc_k, mu;
-  int flags; /* PC_VCONS | PC_TIC: one int, since with two GCC 12 nvptx put the struct in a
-                lane-shared frame (tests/offload_frames.sh) */
+  int flags; /* PC_VCONS | PC_TIC | PC_SHSW: one int, since with two GCC 12 nvptx put the
+                struct in a lane-shared frame (tests/offload_frames.sh) */
 } pass_c_consts;
-enum { PC_VCONS = 1, PC_TIC = 2 }; /* the consistent Laplacian; scheme.tensile_control */
+/* the consistent Laplacian; scheme.tensile_control; scheme.shifting_switch */
+enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4 };
 
 #define PC_PARAMS                                                                                  \
   rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
@@ -694,9 +696,19 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * K.gy + vsy;
   /* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
   real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
-  if (shifting) { /* Eq. 4 */
-    dr += -rhoi * ddu + drdu;
-    fx += ruux, fy += ruuy;
+  if (shifting) {
+    /* Eq. 4: -rho_i <div du> + <div(rho du)> and <div(rho u (x) du)>, sum forms
+     * sum (phi_i + phi_j) grad_i W_ij V_j. With scheme.shifting_switch, where Eq. 6 is
+     * renormalised (the support is full), the difference forms sum (phi_j - phi_i)
+     * grad_i W_ij V_j instead: the sum form carries 2 phi_i sum grad_i W_ij V_j =
+     * 2 phi_i grad Gamma_i, a zeroth-order error wherever grad Gamma_i != 0 inside the
+     * fluid, as at the size jumps of APR (our choice, docs/choices.md "Shifting terms at
+     * size jumps"). The free-surface region keeps the sum forms, as Eq. 6 keeps its
+     * conservative form there. sf = sum grad_i W_ij V_j, so the switch costs nothing in
+     * the loop. */
+    const real dsf = ((K.flags & PC_SHSW) ? renP : 0) * 2 * (dui * sfx + dvi * sfy);
+    dr += -rhoi * ddu + drdu - rhoi * dsf;
+    fx += ruux - rhoi * uxi * dsf, fy += ruuy - rhoi * uyi * dsf;
   }
   drho[i] = dr;
   acc[2 * i] = fx / rhoi, acc[2 * i + 1] = fy / rhoi;
@@ -742,7 +754,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       .tth = s->theta_th,
       .visc_k = 2 * (RHOD_DIM + 2) * s->mu, /* Eq. 10 */
       .mu = s->mu,
-      .flags = (s->visc_cons ? PC_VCONS : 0) | (s->tic ? PC_TIC : 0),
+      .flags = (s->visc_cons ? PC_VCONS : 0) | (s->tic ? PC_TIC : 0) | (s->shsw ? PC_SHSW : 0),
   };
   const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
             shifting = s->shifting, visc = s->mu != 0;

@@ -98,7 +98,7 @@ typedef struct {
   double *shifting_a, *shifting_b, *shifting_eps;
   bool *acoustic_damper;
   double *alpha_ad;
-  bool *tensile_control;
+  bool *tensile_control, *shifting_switch;
   bool *free_surface;
   double *free_surface_lambda;
   double *shepard_threshold, *theta_threshold;
@@ -285,6 +285,7 @@ static const cyaml_schema_field_t f_scheme[] = {
     BOOL_OPT("acoustic_damper", y_scheme, acoustic_damper),
     NUM_OPT("alpha_ad", y_scheme, alpha_ad),
     BOOL_OPT("tensile_control", y_scheme, tensile_control),
+    BOOL_OPT("shifting_switch", y_scheme, shifting_switch),
     BOOL_OPT("free_surface", y_scheme, free_surface),
     VEC("free_surface_lambda", OPT, y_scheme, free_surface_lambda),
     NUM_OPT("shepard_threshold", y_scheme, shepard_threshold),
@@ -1356,6 +1357,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->acoustic_damper = opt_bool(sc->acoustic_damper, 1);
   s->alpha_ad = opt(sc->alpha_ad, 1);
   s->tensile_control = opt_bool(sc->tensile_control, 0);
+  s->shifting_switch = opt_bool(sc->shifting_switch, 0);
   s->free_surface = opt_bool(sc->free_surface, 1);
   s->fs_lambda_low = sc->free_surface_lambda ? sc->free_surface_lambda[0] : 0.2;
   s->fs_lambda_high = sc->free_surface_lambda ? sc->free_surface_lambda[1] : 0.75;
@@ -1710,6 +1712,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_bool(&t, m, "acoustic_damper", s->acoustic_damper);
   tb_num(&t, m, "alpha_ad", s->alpha_ad);
   tb_bool(&t, m, "tensile_control", s->tensile_control);
+  tb_bool(&t, m, "shifting_switch", s->shifting_switch);
   tb_bool(&t, m, "free_surface", s->free_surface);
   double lambda[2] = {s->fs_lambda_low, s->fs_lambda_high};
   tb_vec(&t, m, "free_surface_lambda", lambda);

@@ -57,6 +57,7 @@ static void test_full_scene(void) {
   CU_ASSERT_FALSE(s->acoustic_damper);
   CLOSE(s->alpha_ad, 0.5);
   CU_ASSERT_TRUE(s->tensile_control);
+  CU_ASSERT_TRUE(s->shifting_switch);
   CU_ASSERT_FALSE(s->free_surface);
   CLOSE(s->fs_lambda_low, 0.25);
   CLOSE(s->fs_lambda_high, 0.7);
@@ -140,6 +141,7 @@ static void test_defaults(void) {
   CU_ASSERT_TRUE(s->acoustic_damper);
   CLOSE(s->alpha_ad, 1);
   CU_ASSERT_FALSE(s->tensile_control);
+  CU_ASSERT_FALSE(s->shifting_switch);
   CU_ASSERT_TRUE(s->free_surface);
   CLOSE(s->fs_lambda_low, 0.2);
   CLOSE(s->fs_lambda_high, 0.75);

@@ -161,6 +161,9 @@ typedef struct {
   int tensile_control;                /* scheme.tensile_control: P_j - P_i in the conservative
                                         Eq. 6 where P_i < 0, off the free surface (paper 001
                                         Eq. 5); default off */
+  int shifting_switch;                /* scheme.shifting_switch: the Eq. 4 divergences in the
+                                         difference form where Eq. 6 is renormalised; default
+                                         off (the paper's sum form everywhere) */
   int free_surface; /* scheme.free_surface: detection of Ref. 51 and the Eq. 6 switch;
                        off: every particle is inner */
   double fs_lambda_low, fs_lambda_high; /* scheme.free_surface_lambda: [0.2, 0.75] */

@@ -16,6 +16,7 @@ typedef struct {
   real cfl, cfl_visc;
   int riemann, recon, shifting, damper, fsdetect;
   int tic;       /* scheme.tensile_control */
+  int shsw;      /* scheme.shifting_switch */
   int visc_cons; /* scheme.viscosity: consistent (and mu > 0) */
   int generic;   /* 1: the general copies of the gathers, never the specialised ones
                     (tests/test_kernels.c compares them) */
