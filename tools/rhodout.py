@@ -98,3 +98,29 @@ def stamp(command):
     commit = subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip()
     return f"Date {datetime.date.today()}, commit {commit}, machine {machine()}, command `{command}`"
+
+
+def wendland(q, R):
+    """W and dW/dr of the 2D Wendland C2 kernel (rhod's default) with support radius R."""
+    c = 7 / (np.pi * R * R)
+    inside = q < 1
+    w = np.where(inside, c * (1 - q) ** 4 * (1 + 4 * q), 0.0)
+    dw = np.where(inside, c * (-20 * q * (1 - q) ** 3) / R, 0.0)
+    return w, dw
+
+
+def mirror_walls(pos, walls, reach):
+    """The particles plus their mirror images in straight walls, as the run's free-slip
+    ghosts: walls is a list of (axis, coordinate); images of the particles within reach.
+    Returns (positions, index of each point's source particle, 2 x 2 map of each point's
+    velocity from its source's: identity, or the axis's component flipped)."""
+    n = len(pos)
+    allpos, src, maps = [pos], [np.arange(n)], [np.tile(np.eye(2), (n, 1, 1))]
+    for axis, c in walls:
+        near = np.where(np.abs(pos[:, axis] - c) < reach)[0]
+        mp = pos[near].copy()
+        mp[:, axis] = 2 * c - mp[:, axis]
+        m = np.eye(2)
+        m[axis, axis] = -1
+        allpos.append(mp), src.append(near), maps.append(np.tile(m, (len(near), 1, 1)))
+    return np.concatenate(allpos), np.concatenate(src), np.concatenate(maps)
