@@ -75,6 +75,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   s->fsdetect = sc->free_surface;
   s->tic = sc->tensile_control;
   s->shsw = sc->shifting_switch;
+  s->adlim = sc->acoustic_damper && sc->damper_step_limit;
   s->alpha_ad = (real)sc->alpha_ad;
   s->sa = (real)sc->shift_a;
   s->sb = (real)sc->shift_b;
@@ -111,6 +112,12 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   if (s->visc_cons) /* a scene without it does not carry it */
     F(lapB, 3);
   F(pk, PK_ROWS);
+  if (s->adlim) {
+    st = st == RHOD_OK ? rhod_particles_add_field(p, "adv", (void **)&s->adv, 2 * sizeof *s->adv, 1)
+                       : st;
+    F(adD, 1);
+    F(adG, 4);
+  }
 #undef F
   return st;
 }
@@ -788,6 +795,139 @@ void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt) {
   rhod_sph_pass_c(s, p, c);
 }
 
+/* The damper step limit (our choice; paper 002 does not discuss it; docs/choices.md
+ * "Damper step limit"). Eq. 9 with D from Eq. 5 is linear in u: F^AD / rho = A u, a bulk
+ * viscosity alpha c0 h integrated explicitly, whose eigenvalues are real and negative.
+ * Eq. 11 keeps dt |lambda| below RK4's bound of 2.785 on a regular support (a lattice at
+ * cfl 0.5: 1.43), but not in a film one particle thick on a wall, where the four-level
+ * dam break reached 4.46 and stopped (cases/dam_break_lobovsky/RESULTS.md). So the
+ * largest |lambda| is measured: one power iteration per step on an iterate carried with
+ * the particles (and checkpointed, so that a resumed run takes the same steps), plus a
+ * small reproducible perturbation that lets a new stiff mode grow into it, and
+ * rhod_sph_dt keeps dt |lambda| <= RHOD_AD_TARGET. A measures what the run integrates:
+ * the ghosts carry the iterate mapped as the velocity (T v) and the divergence as pass A's
+ * mirror (the source's, or the trace of the mapped renormalised gradient). */
+
+/* a reproducible number in [-1, 1) per particle id and component (splitmix64) */
+static inline real id_noise(uint64_t id, uint64_t comp) {
+  uint64_t z = id * 2 + comp + 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  z ^= z >> 31;
+  return (real)((double)(z >> 11) * (2.0 / 9007199254740992.0) - 1.0);
+}
+
+real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n, nt = (long)(p->n + p->ng), st = (long)p->cap;
+  if (n == 0)
+    return 0;
+  real *v = s->adv, *aD = s->adD, *aG = s->adG, *pk = s->pk;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *rho = p->rho, *V = s->V;
+  const real *gJ = p->gJ, *gT = p->gT;
+  const uint64_t *id = p->id;
+  const int32_t *gsrc = p->gsrc, *CI = c->idx, *CS = c->start;
+  const rhod_grid G = c->g;
+  const int kern = s->kernel;
+  const real ratio = s->ratio, kad = s->alpha_ad * s->rho0 * s->c0 * (real)0.5; /* Eq. 9 */
+  /* normalise the iterate and add the perturbation: components in [-1, 1) have a mean
+   * square of 1/3, so sqrt(1.5 / n) gives the perturbation a norm near 1, weighted 0.05
+   * (all of it for the first iterate) */
+  real nv = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, nv)
+  for (long i = 0; i < n; i++)
+    nv += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
+  const real a = nv > 0 ? 1 / sqrt(nv) : 0;
+  const real b = (nv > 0 ? (real)0.05 : 1) * sqrt((real)1.5 / (real)n);
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    v[2 * i] = a * v[2 * i] + b * id_noise(id[i], 0);
+    v[2 * i + 1] = a * v[2 * i + 1] + b * id_noise(id[i], 1);
+  }
+  /* the ghosts' iterate, as their velocity (rhod_sph_fill_state), and the rows of the
+   * first gather */
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++) {
+    const int k = gsrc[g];
+    const real *T = gT + 4 * g;
+    v[2 * g] = T[0] * v[2 * k] + T[1] * v[2 * k + 1];
+    v[2 * g + 1] = T[2] * v[2 * k] + T[3] * v[2 * k + 1];
+  }
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt; k++) {
+    const int j = CI[k];
+    pk[PK_X * st + k] = x[j], pk[PK_Y * st + k] = y[j], pk[PK_V * st + k] = V[j];
+    pk[PK_UX * st + k] = v[2 * j], pk[PK_UY * st + k] = v[2 * j + 1];
+  }
+  /* D of the iterate (Eq. 5) and its renormalised gradient (Eqs. 8 and 14, as pass A) */
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st,
+               *kvx = pk + PK_UX * st, *kvy = pk + PK_UY * st;
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
+    const real iR = 1 / Ri, iR3 = iR * iR * iR, vxi = v[2 * i], vyi = v[2 * i + 1];
+    real B0 = 0, B1 = 0, B2 = 0, B3 = 0, G0 = 0, G1 = 0, G2 = 0, G3 = 0;
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+      RHOD_SIMD(reduction(+ : B0, B1, B2, B3, G0, G1, G2, G3))
+      for (int k = k0; k < k1; k++) {
+        PAIR_OR_SKIP(k);
+        const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
+        const real gwx = F * nx, gwy = F * ny, dvx = kvx[k] - vxi, dvy = kvy[k] - vyi;
+        B0 += rx * gwx, B1 += rx * gwy, B2 += ry * gwx, B3 += ry * gwy;
+        G0 += dvx * gwx, G1 += dvx * gwy, G2 += dvy * gwx, G3 += dvy * gwy;
+      }
+    }
+    RHOD_END_ROWS
+    aD[i] = G0 + G3;
+    const real det = B0 * B3 - B1 * B2;
+    real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
+    if (det > (real)1e-2) {
+      const real id_ = 1 / det;
+      L0 = B3 * id_, L1 = -B1 * id_, L2 = -B2 * id_, L3 = B0 * id_;
+    }
+    aG[4 * i] = L0 * G0 + L2 * G1, aG[4 * i + 1] = L1 * G0 + L3 * G1;
+    aG[4 * i + 2] = L0 * G2 + L2 * G3, aG[4 * i + 3] = L1 * G2 + L3 * G3;
+  }
+  /* the ghosts' D as rhod_sph_mirror_gradients's, and the row of the second gather */
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++) {
+    const int k = gsrc[g];
+    const real *J = gJ + 4 * g, *T = gT + 4 * g, *U = aG + 4 * k;
+    const int same = T[0] == J[0] && T[1] == J[1] && T[2] == J[2] && T[3] == J[3];
+    /* trace of (T U) J^T */
+    const real M0 = T[0] * U[0] + T[1] * U[2], M1 = T[0] * U[1] + T[1] * U[3];
+    const real M2 = T[2] * U[0] + T[3] * U[2], M3 = T[2] * U[1] + T[3] * U[3];
+    aD[g] = same ? aD[k] : M0 * J[0] + M1 * J[1] + M2 * J[2] + M3 * J[3];
+  }
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt; k++)
+    pk[PK_D * st + k] = aD[CI[k]];
+  /* F^AD / rho of the iterate (Eq. 9, h_i = R_i / 2 as in pass C), which becomes the next
+   * iterate; |A v| / |v| estimates the largest |lambda| */
+  real nw = 0, n0 = 0;
+  RHOD_KERNEL_LOOP_REDUCE2(+, nw, n0)
+  for (long i = 0; i < n; i++) {
+    const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st,
+               *kD = pk + PK_D * st;
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri, Di = aD[i];
+    const real iR = 1 / Ri, iR3 = iR * iR * iR;
+    real fx = 0, fy = 0;
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+      RHOD_SIMD(reduction(+ : fx, fy))
+      for (int k = k0; k < k1; k++) {
+        PAIR_OR_SKIP(k);
+        const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k] * (kD[k] + Di);
+        fx += F * nx, fy += F * ny;
+      }
+    }
+    RHOD_END_ROWS
+    const real ki = kad * Ri / rho[i];
+    n0 += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
+    v[2 * i] = ki * fx, v[2 * i + 1] = ki * fy;
+    nw += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
+  }
+  return n0 > 0 ? sqrt(nw / n0) : 0;
+}
+
 real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {
   const long n = (long)p->n;
   const real *dx = p->dx;
@@ -805,6 +945,11 @@ real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {
   if (s->mu > 0) {
     const real d3 = s->cfl_visc * s->rho0 * R * R / s->mu;
     dt = d3 < dt ? d3 : dt;
+  }
+  /* the damper step limit (rhod_sph_damper_probe) */
+  if (s->adlim && s->ad_lambda > 0) {
+    const real d4 = (real)RHOD_AD_TARGET / s->ad_lambda;
+    dt = d4 < dt ? d4 : dt;
   }
   return dt;
 }

@@ -1,5 +1,6 @@
-/* Whole RK4 step of single-resolution RHOD-SPH: microseconds per particle-step and
- * bytes per particle. usage: bench_step [N=1e4] [steps=20] [box|patch] */
+/* Whole RK4 step of single-resolution RHOD-SPH, with the step size as a run takes it
+ * (rhod_sim_dt: the damper probe included): microseconds per particle-step and bytes
+ * per particle. usage: bench_step [N=1e4] [steps=20] [box|patch] [switch ...] (bench_common.h) */
 #include "bench_common.h"
 
 int main(int argc, char **argv) {
@@ -19,7 +20,7 @@ int main(int argc, char **argv) {
   const double t0 = bench_now();
   for (int k = 0; k < steps; k++) {
     rhod_sim_prepare(&s, 1);
-    if (rhod_sim_step(&s, s.dt, err, sizeof err) != RHOD_OK) {
+    if (rhod_sim_dt(&s) != RHOD_OK || rhod_sim_step(&s, s.dt, err, sizeof err) != RHOD_OK) {
       fprintf(stderr, "bench_step: %s\n", err);
       return 1;
     }

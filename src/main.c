@@ -201,11 +201,11 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
                         "  \"us_per_particle_step\": %.6g,\n  \"precision\": \"%s\",\n"
                         "  \"threads\": %d,\n  \"kernels_ran_on\": \"%s\",\n"
                         "  \"wall_reflections\": %ld,\n  \"splits\": %ld,\n  \"merges\": %ld,\n"
-                        "  \"probes\": {",
+                        "  \"damper_limited_steps\": %ld,\n  \"probes\": {",
                         status, cause, c->sc->path, s->p.n, s->step, s->t, s->dt, wall,
                         psteps > 0 ? 1e6 * wall / psteps : 0.0, RHOD_REAL_NAME,
                         omp_get_max_threads(), c->where, s->reflected, s->apr.split_total,
-                        s->apr.merged_total);
+                        s->apr.merged_total, s->damper_limited);
   for (unsigned k = 0; k < c->nprobe_cols && o < sizeof buf - 200; k++)
     o += (size_t)snprintf(buf + o, sizeof buf - o, "%s\n    \"%s\": %.9g", k ? "," : "",
                           c->probe_names[k], c->probe_vals ? c->probe_vals[k] : 0.0);
@@ -463,6 +463,11 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
         goto cleanup;
       }
     }
+    st = rhod_sim_dt(s);
+    if (st != RHOD_OK) {
+      snprintf(err, sizeof err, "out of memory for ghost particles at t = %g s", s->t);
+      goto fail;
+    }
     double dt = s->dt;
     /* land exactly on output times and on the end */
     const double stop = fmin(t_end, next_out);
@@ -507,6 +512,10 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       logline("rhod: %ld particle-steps ended just behind a wall and were reflected back "
               "(docs/choices.md)",
               s->reflected);
+    if (s->damper_limited)
+      logline("rhod: %ld of the %ld steps run here took a dt set by the acoustic damper's "
+              "measured stiffness (scheme.damper_step_limit)",
+              s->damper_limited, s->step - c.step0);
     st = write_summary(&c, "ok", "", wall);
   }
   goto cleanup;

@@ -98,6 +98,7 @@ typedef struct {
   double *shifting_a, *shifting_b, *shifting_eps;
   bool *acoustic_damper;
   double *alpha_ad;
+  bool *damper_step_limit;
   bool *tensile_control, *shifting_switch;
   bool *free_surface;
   double *free_surface_lambda;
@@ -284,6 +285,7 @@ static const cyaml_schema_field_t f_scheme[] = {
     NUM_OPT("shifting_eps", y_scheme, shifting_eps),
     BOOL_OPT("acoustic_damper", y_scheme, acoustic_damper),
     NUM_OPT("alpha_ad", y_scheme, alpha_ad),
+    BOOL_OPT("damper_step_limit", y_scheme, damper_step_limit),
     BOOL_OPT("tensile_control", y_scheme, tensile_control),
     BOOL_OPT("shifting_switch", y_scheme, shifting_switch),
     BOOL_OPT("free_surface", y_scheme, free_surface),
@@ -1356,6 +1358,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->shift_eps = opt(sc->shifting_eps, 5e-4);
   s->acoustic_damper = opt_bool(sc->acoustic_damper, 1);
   s->alpha_ad = opt(sc->alpha_ad, 1);
+  s->damper_step_limit = opt_bool(sc->damper_step_limit, 1);
   s->tensile_control = opt_bool(sc->tensile_control, 0);
   s->shifting_switch = opt_bool(sc->shifting_switch, 0);
   s->free_surface = opt_bool(sc->free_surface, 1);
@@ -1711,6 +1714,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "shifting_eps", s->shift_eps);
   tb_bool(&t, m, "acoustic_damper", s->acoustic_damper);
   tb_num(&t, m, "alpha_ad", s->alpha_ad);
+  tb_bool(&t, m, "damper_step_limit", s->damper_step_limit);
   tb_bool(&t, m, "tensile_control", s->tensile_control);
   tb_bool(&t, m, "shifting_switch", s->shifting_switch);
   tb_bool(&t, m, "free_surface", s->free_surface);

@@ -487,6 +487,21 @@ static int check_state(rhod_sim *s, char *err, size_t errlen) {
   return RHOD_ERR_UNSTABLE;
 }
 
+int rhod_sim_dt(rhod_sim *s) {
+  if (s->sph.adlim) {
+    if (!s->neighbours_fresh) {
+      const int st = rhod_sim_prepare(s, 1);
+      if (st != RHOD_OK)
+        return st;
+    }
+    s->sph.ad_lambda = rhod_sph_damper_probe(&s->sph, &s->p, &s->cells);
+  }
+  s->dt = rhod_sph_dt(&s->sph, &s->p);
+  if (s->sph.adlim && s->sph.ad_lambda > 0 && s->dt == (real)RHOD_AD_TARGET / s->sph.ad_lambda)
+    s->damper_limited++;
+  return RHOD_OK;
+}
+
 int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   rhod_particles *p = &s->p;
   int st;

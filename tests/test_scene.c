@@ -56,6 +56,7 @@ static void test_full_scene(void) {
   CLOSE(s->shift_eps, 4e-4);
   CU_ASSERT_FALSE(s->acoustic_damper);
   CLOSE(s->alpha_ad, 0.5);
+  CU_ASSERT_FALSE(s->damper_step_limit);
   CU_ASSERT_TRUE(s->tensile_control);
   CU_ASSERT_TRUE(s->shifting_switch);
   CU_ASSERT_FALSE(s->free_surface);
@@ -140,6 +141,7 @@ static void test_defaults(void) {
   CLOSE(s->shift_eps, 5e-4);
   CU_ASSERT_TRUE(s->acoustic_damper);
   CLOSE(s->alpha_ad, 1);
+  CU_ASSERT_TRUE(s->damper_step_limit);
   CU_ASSERT_FALSE(s->tensile_control);
   CU_ASSERT_FALSE(s->shifting_switch);
   CU_ASSERT_TRUE(s->free_surface);

@@ -158,6 +158,8 @@ typedef struct {
   double shift_a, shift_b, shift_eps; /* scheme.shifting_a/b/eps: 0.5, 0.05, 5e-4 (Eq. 27) */
   int acoustic_damper;                /* scheme.acoustic_damper: Eq. 9 */
   double alpha_ad;                    /* scheme.alpha_ad: 1 */
+  int damper_step_limit;              /* scheme.damper_step_limit: dt also kept below the
+                                         damper's measured stiffness (rhod_sph.c); default on */
   int tensile_control;                /* scheme.tensile_control: P_j - P_i in the conservative
                                         Eq. 6 where P_i < 0, off the free surface (paper 001
                                         Eq. 5); default off */

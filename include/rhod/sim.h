@@ -31,6 +31,7 @@ typedef struct {
   long step;
   double particle_steps; /* sum over the steps run by this process of the particle count */
   long reflected;        /* particles put back by the wall-crossing guard, whole run */
+  long damper_limited;   /* steps of this process whose dt the damper step limit set */
   int neighbours_fresh;  /* ghosts and cells match the current state */
 } rhod_sim;
 
@@ -42,6 +43,11 @@ void rhod_sim_free(rhod_sim *s);
 /* Makes ghosts and cells match the current state (sorting the fluid by cell first when
  * sort != 0). After it, probes and outputs see consistent ghost values. */
 int rhod_sim_prepare(rhod_sim *s, int sort);
+
+/* Sets s->dt for the next step: Eq. 11, and with the damper step limit a measurement of
+ * the damper's stiffness first (rhod_sph_damper_probe; one per call, so call it once per
+ * step). Returns RHOD_OK or RHOD_ERR_MEMORY. */
+int rhod_sim_dt(rhod_sim *s);
 
 /* One RK4 step of size s->dt (clipped by the caller). Then checks the new state:
  * RHOD_ERR_UNSTABLE with the particle and the cause in err when it is not finite or a

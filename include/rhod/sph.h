@@ -17,10 +17,13 @@ typedef struct {
   int riemann, recon, shifting, damper, fsdetect;
   int tic;       /* scheme.tensile_control */
   int shsw;      /* scheme.shifting_switch */
+  int adlim;     /* scheme.damper_step_limit (and the damper on) */
   int visc_cons; /* scheme.viscosity: consistent (and mu > 0) */
   int generic;   /* 1: the general copies of the gathers, never the specialised ones
                     (tests/test_kernels.c compares them) */
   real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
+  real ad_lambda; /* largest |eigenvalue| of Eq. 9 as last measured (rhod_sph_damper_probe);
+                     0: none */
   /* per-particle fields (scratch, rebuilt each stage) */
   real *P, *V;
   real *gam, *ggam;       /* Shepard Gamma (Eq. 7) and its gradient (Eq. 27), 2 */
@@ -40,6 +43,10 @@ typedef struct {
   uint8_t *fs;            /* 1: free-surface particle (set F) */
   uint8_t *reg;           /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
   real *pk;               /* neighbour-side fields packed in cell order (rhod_sph.c) */
+  real *adv;              /* with adlim: the damper probe's iterate (2, carried across
+                             steps and checkpointed), its divergence (adD, 1) and gradient
+                             (adG, 4) */
+  real *adD, *adG;
 } rhod_sph;
 
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p);
@@ -62,7 +69,18 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c);
 void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt);
 void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 
-/* Time step of Eq. 11 over the fluid. */
+/* Target of the damper step limit: dt |lambda| of Eq. 9 kept at or below this, RK4
+ * being stable down to dt lambda = -2.785 on the real axis (rhod_sph.c). */
+#define RHOD_AD_TARGET 2.2
+
+/* One power iteration of the acoustic damper's operator (Eq. 9 with Eq. 5, linear in u)
+ * on the carried iterate: returns the estimate of its largest |eigenvalue| (1/s). The
+ * neighbour structure must be built (ghosts, cells, rhod_sph_fill_state); it overwrites
+ * the packed rows of the gathers, which the next pass A and pass C pack again. */
+real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
+
+/* Time step of Eq. 11 over the fluid, and with adlim no more than RHOD_AD_TARGET /
+ * ad_lambda. */
 real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p);
 
 #endif
