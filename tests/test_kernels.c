@@ -703,7 +703,7 @@ static void test_damper_probe(void) {
       /* on a finite lattice the top modes are close: the estimate may still be low */
       CU_ASSERT(lam > 0.9 * ref && lam <= 1.0001 * ref);
       CU_ASSERT(dt11 * ref < RHOD_AD_TARGET);
-      CU_ASSERT_DOUBLE_EQUAL(dt, dt11, 1e-12); /* not binding */
+      CU_ASSERT_DOUBLE_EQUAL(dt, dt11, TOL(1e-9, 1e-6) * dt11); /* not binding */
     }
     if (wall)
       rhod_boundary_free(&b);
