@@ -343,6 +343,18 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   }
 }
 
+/* div u of a ghost (shared by rhod_sph_mirror_gradients and the damper probe): the
+ * source's own raw (Eq. 5) value Dk where the map keeps it (T = J: free slip, periodic),
+ * else the trace of the mapped gradient (T U) J^T (no slip), U the source's renormalised
+ * gradient (row-major) */
+static inline real ghost_div(const real *J, const real *T, const real *U, real Dk) {
+  if (T[0] == J[0] && T[1] == J[1] && T[2] == J[2] && T[3] == J[3])
+    return Dk;
+  const real M0 = T[0] * U[0] + T[1] * U[2], M1 = T[0] * U[1] + T[1] * U[3];
+  const real M2 = T[2] * U[0] + T[3] * U[2], M3 = T[2] * U[1] + T[3] * U[3];
+  return (M0 * J[0] + M1 * J[1]) + (M2 * J[2] + M3 * J[3]);
+}
+
 /* Ghost copies of the pass A gradients: grad P' = e^a J grad P + rho' (I - J) g, the
  * gradient at the ghost of the hydrostatic-corrected ghost pressure of
  * rhod_sph_fill_state (P' = c0^2 (rho e^a - rho0), a = g . (x' - x) / c0^2, x' = J x + b,
@@ -372,10 +384,7 @@ void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p) {
     O[1] = M0 * J[2] + M1 * J[3];
     O[2] = M2 * J[0] + M3 * J[1];
     O[3] = M2 * J[2] + M3 * J[3];
-    /* div u of the ghost: the source's own (raw, Eq. 5) value where the map keeps it
-     * (T = J: free slip, periodic), else the trace of the mapped gradient (no slip) */
-    const int same = T[0] == J[0] && T[1] == J[1] && T[2] == J[2] && T[3] == J[3];
-    D[g] = same ? D[k] : O[0] + O[3];
+    D[g] = ghost_div(J, T, U, D[k]);
   }
 }
 
@@ -887,16 +896,11 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     aG[4 * i] = L0 * G0 + L2 * G1, aG[4 * i + 1] = L1 * G0 + L3 * G1;
     aG[4 * i + 2] = L0 * G2 + L2 * G3, aG[4 * i + 3] = L1 * G2 + L3 * G3;
   }
-  /* the ghosts' D as rhod_sph_mirror_gradients's, and the row of the second gather */
+  /* the ghosts' D (ghost_div, as rhod_sph_mirror_gradients), and the second gather's row */
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++) {
     const int k = gsrc[g];
-    const real *J = gJ + 4 * g, *T = gT + 4 * g, *U = aG + 4 * k;
-    const int same = T[0] == J[0] && T[1] == J[1] && T[2] == J[2] && T[3] == J[3];
-    /* trace of (T U) J^T */
-    const real M0 = T[0] * U[0] + T[1] * U[2], M1 = T[0] * U[1] + T[1] * U[3];
-    const real M2 = T[2] * U[0] + T[3] * U[2], M3 = T[2] * U[1] + T[3] * U[3];
-    aD[g] = same ? aD[k] : M0 * J[0] + M1 * J[1] + M2 * J[2] + M3 * J[3];
+    aD[g] = ghost_div(gJ + 4 * g, gT + 4 * g, aG + 4 * k, aD[k]);
   }
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nt; k++)
