@@ -529,6 +529,17 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   }
 }
 
+/* J_i = -R_i grad C_i (Eq. 25) projected in the free-surface region (Eq. 26), into the
+ * locals Jx, Jy; reads ratio, dx, gC, nt and sig. A macro, not a function with pointer
+ * outputs (addressable locals on nvptx, offload.md). */
+#define SHIFT_J(i, Jx, Jy)                                                                         \
+  real Jx = -ratio * dx[i] * gC[2 * (i)], Jy = -ratio * dx[i] * gC[2 * (i) + 1];                   \
+  do {                                                                                             \
+    const real nx_ = nt[2 * (i)], ny_ = nt[2 * (i) + 1];                                           \
+    const real jn_ = sig[i] * (Jx * nx_ + Jy * ny_);                                               \
+    Jx -= jn_ * nx_, Jy -= jn_ * ny_;                                                              \
+  } while (0)
+
 /* Shifting velocity, Eqs. 25-27 (no gather: grad C and U_char come from pass A). */
 void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
   const long n = (long)p->n, nt_ = (long)(p->n + p->ng);
@@ -543,11 +554,7 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
   const real ratio = s->ratio, a = s->sa, b = s->sb, eps = s->seps;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
-    const real Ri = ratio * dx[i];
-    real Jx = -Ri * gC[2 * i], Jy = -Ri * gC[2 * i + 1]; /* Eq. 25 */
-    const real nx = nt[2 * i], ny = nt[2 * i + 1];
-    const real jn = sig[i] * (Jx * nx + Jy * ny); /* Eq. 26 */
-    Jx -= jn * nx, Jy -= jn * ny;
+    SHIFT_J(i, Jx, Jy);
     const real jm = sqrt(Jx * Jx + Jy * Jy);
     real f = a * uch[i]; /* Eq. 27 */
     if (jm > 0) {
@@ -570,6 +577,45 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
     const real vx = du[2 * k], vy = du[2 * k + 1];
     du[2 * g] = J[0] * vx + J[1] * vy;
     du[2 * g + 1] = J[2] * vx + J[3] * vy;
+  }
+}
+
+/* One iteration of the initial relaxation (particles.relax; our choice, docs/choices.md
+ * "initial relaxation"). Paper 002 packs its initial particles with the algorithm of its
+ * Ref. 16, which it does not restate; we move them instead along the scheme's own
+ * shifting direction: delta x_i = f_i J_i with J_i of Eqs. 25-26 (so the free surface
+ * keeps its place: only the tangential part moves F particles) and
+ * f_i = min(RHOD_RELAX_BETA dx_i, RHOD_RELAX_STEP dx_i / |J_i|, eps / (2 |J_i . grad Gamma_i|)),
+ * Eq. 27 with U_char dt replaced by a fixed fraction of the particle's size: J = -R grad C
+ * makes it a diffusion of the concentration with coefficient RHOD_RELAX_BETA R dx, the
+ * step is at most RHOD_RELAX_STEP dx, and the last bound is Eq. 27's own limit on the
+ * change of Gamma. Needs the cells and ghosts of the current positions (rhod_sim_prepare);
+ * moves the fluid particles only and leaves every other field as it was. */
+void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
+  rhod_sph_pass_a(s, p, c);
+  rhod_sph_mirror_gradients(s, p);
+  rhod_sph_pass_free_surface(s, p, c);
+  rhod_sph_mirror_surface(s, p);
+  rhod_sph_pass_region(s, p, c);
+  const long n = (long)p->n;
+  real *x = p->x, *y = p->y;
+  const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *ggam = s->ggam, *dx = p->dx;
+  const real ratio = s->ratio, eps = s->seps;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    SHIFT_J(i, Jx, Jy);
+    const real jm = sqrt(Jx * Jx + Jy * Jy);
+    if (!(jm > 0))
+      continue;
+    real f = (real)RHOD_RELAX_BETA * dx[i];
+    const real f2 = (real)RHOD_RELAX_STEP * dx[i] / jm;
+    f = f2 < f ? f2 : f;
+    const real jg = fabs(Jx * ggam[2 * i] + Jy * ggam[2 * i + 1]);
+    if (jg > 0) {
+      const real f3 = eps / (2 * jg);
+      f = f3 < f ? f3 : f;
+    }
+    x[i] += f * Jx, y[i] += f * Jy;
   }
 }
 

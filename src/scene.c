@@ -84,6 +84,7 @@ typedef struct {
   double *radius_ratio;
   int *kernel;
   double *jitter;
+  double *relax;
 } y_particles;
 
 typedef struct {
@@ -267,6 +268,7 @@ static const cyaml_schema_field_t f_particles[] = {
     NUM("dx", y_particles, dx),
     NUM_OPT("radius_ratio", y_particles, radius_ratio),
     NUM_OPT("jitter", y_particles, jitter),
+    NUM_OPT("relax", y_particles, relax),
     ENUM_OPT("kernel", y_particles, kernel, kernel_names),
     CYAML_FIELD_END,
 };
@@ -1335,6 +1337,11 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   TRY(check_range(c, "particles.radius_ratio", s->radius_ratio, 2, 0, 8, 0));
   s->jitter = opt(d->particles.jitter, 0);
   TRY(check_range(c, "particles.jitter", s->jitter, 0, 0, 0.5, 0));
+  const double relax = opt(d->particles.relax, 0);
+  if (!(relax >= 0 && relax <= RHOD_RELAX_MAX && relax == floor(relax)))
+    return fail(c, "particles.relax", "must be a whole number in [0, %d], got %g", RHOD_RELAX_MAX,
+                relax);
+  s->relax = (int)relax;
   /* physics */
   s->rho0 = opt(d->physics.rho0, 1000);
   s->c0 = d->physics.c0;
@@ -1698,6 +1705,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "dx", s->dx);
   tb_num(&t, m, "radius_ratio", s->radius_ratio);
   tb_num(&t, m, "jitter", s->jitter);
+  if (s->relax > 0) /* absent at 0, so checkpoints made before the key resume */
+    tb_num(&t, m, "relax", s->relax);
   tb_word(&t, m, "kernel",
           strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
   m = tb_coll(&t, root, "physics", RY_MAP, 0);

@@ -265,6 +265,44 @@ static int restate_initial(rhod_sim *s) {
   return rhod_sim_prepare(s, 1);
 }
 
+static int refine_initial(rhod_sim *s, char *err, size_t errlen);
+
+/* The initial relaxation (particles.relax, rhod_sph_relax): the particles move along the
+ * shifting direction for that many iterations, then each gets the exact initial fields of
+ * the block it was made in, where it now stands (set_state: a particle that left its
+ * block, e.g. a surface particle by a fraction of dx, takes the block's fields extended
+ * there). Sizes, ids and the count are kept. */
+static int relax_initial(rhod_sim *s) {
+  rhod_particles *p = &s->p;
+  rhod_particles_to_host(p);
+  /* the block of each particle, by id (the sorts of the iterations reorder them) */
+  const size_t nid = (size_t)p->next_id;
+  int *blk = malloc((nid ? nid : 1) * sizeof *blk);
+  if (!blk)
+    return RHOD_ERR_MEMORY;
+  for (size_t k = 0; k < p->n; k++)
+    blk[p->id[k]] = fluid_block_at(s, p->x[k], p->y[k]);
+  int st = RHOD_OK;
+  for (int it = 0; it < s->sc->relax && st == RHOD_OK; it++) {
+    rhod_sph_relax(&s->sph, p, &s->cells);
+    rhod_walls_guard(&s->bnd, p);
+    st = rhod_sim_prepare(s, 1);
+  }
+  if (st == RHOD_OK) {
+    rhod_particles_to_host(p);
+    for (size_t k = 0; k < p->n; k++) {
+      const uint64_t id = p->id[k];
+      if (blk[id] >= 0)
+        set_state(s, (unsigned)blk[id], k, p->x[k], p->y[k], p->dx[k]);
+      p->id[k] = id;
+    }
+    rhod_particles_to_device(p);
+    st = rhod_sim_prepare(s, 1);
+  }
+  free(blk);
+  return st;
+}
+
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   memset(s, 0, sizeof *s);
   s->sc = sc;
@@ -350,8 +388,18 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   st = rhod_sim_prepare(s, 1);
   if (st != RHOD_OK)
     return st;
-  if (!s->apr.active)
-    return RHOD_OK;
+  if (s->apr.active)
+    st = refine_initial(s, err, errlen);
+  if (st == RHOD_OK && sc->relax > 0 && (st = relax_initial(s)) != RHOD_OK)
+    snprintf(err, errlen, "out of memory relaxing the initial particles");
+  return st;
+}
+
+/* The initial lattice refined by the criteria (rhod_sim_init). */
+static int refine_initial(rhod_sim *s, char *err, size_t errlen) {
+  const rhod_scene *sc = s->sc;
+  rhod_particles *p = &s->p;
+  int st;
   /* The initial lattice is refined by the criteria before the first step, until none
    * asks for more, so the run starts from a layout that satisfies them (paper 002
    * Sec. V B: "the initial particle setup is chosen to naturally ensure the criteria")

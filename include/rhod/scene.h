@@ -101,6 +101,8 @@ typedef enum {
 
 /* Most particle sizes a scene may use: dx, dx/e, ..., dx/e^(RHOD_MAX_LEVELS-1). */
 #define RHOD_MAX_LEVELS 8
+/* Most iterations of the initial relaxation (particles.relax). */
+#define RHOD_RELAX_MAX 100000
 
 /* scheme.viscosity: how F^mu approximates mu lap u. Monaghan: paper 002 Eq. 10 (the
  * default). Consistent: exact for quadratic velocity fields on any particle cloud, in
@@ -145,6 +147,8 @@ typedef struct {
   rhod_kernel_kind kernel; /* particles.kernel, default wendland_c2 */
   double jitter;           /* particles.jitter: random shift of the initial lattice points,
                               a fraction of dx in [0, 0.5], default 0 */
+  int relax;               /* particles.relax: iterations of the initial relaxation by the
+                              shifting operator (before t = 0), default 0 */
   /* physics: */
   double rho0;       /* physics.rho0 [kg/m^3], default 1000 */
   double c0;         /* physics.c0 [m/s] (required), Eq. 2 */

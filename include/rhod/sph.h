@@ -68,10 +68,17 @@ void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p);
 void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c);
 void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt);
 void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
+/* One iteration of the initial relaxation (particles.relax): moves the fluid particles
+ * along the shifting direction J of Eqs. 25-26; cells and ghosts must be current. */
+void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c);
 
 /* Target of the damper step limit: dt |lambda| of Eq. 9 kept at or below this, RK4
  * being stable down to dt lambda = -2.785 on the real axis (rhod_sph.c). */
 #define RHOD_AD_TARGET 2.2
+/* The initial relaxation's step (rhod_sph_relax): coefficient of delta x = beta dx J and
+ * the largest step, both in units of the particle's size. */
+#define RHOD_RELAX_BETA 0.25
+#define RHOD_RELAX_STEP 0.1
 
 /* One power iteration of the acoustic damper's operator (Eq. 9 with Eq. 5, linear in u)
  * on the carried iterate: returns the estimate of its largest |eigenvalue| (1/s). The
