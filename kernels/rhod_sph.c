@@ -330,7 +330,7 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const int kern = s->kernel, vcons = s->visc_cons, generic = s->generic;
   const real ratio = s->ratio;
   (void)generic;
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
 #ifdef RHOD_OFFLOAD
     pass_a_particle(i, PA_ARGS, kern);
@@ -406,7 +406,7 @@ void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
   const real lo = s->lam_lo, hi = s->lam_hi, ratio = s->ratio;
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     /* normal n = -L^T grad Gamma / |.| (outward) */
     const real *Li = L + 4 * i;
@@ -495,7 +495,7 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   const uint8_t *mark = c->mark;
   const int kern = s->kernel;
   const real ratio = s->ratio;
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
     if (!rhod_cells_near_mark(G, mark, xi, yi, Ri)) {
@@ -824,7 +824,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
                       ? -1
                       : 4 * (riemann + recon) + 2 * shifting + visc;
   (void)sel;
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
 #ifdef RHOD_OFFLOAD
     pass_c_particle(i, PC_ARGS, kern, riemann, recon, shifting, visc);
@@ -914,7 +914,7 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     pk[PK_UX * st + k] = v[2 * j], pk[PK_UY * st + k] = v[2 * j + 1];
   }
   /* D of the iterate (Eq. 5) and its renormalised gradient (Eqs. 8 and 14, as pass A) */
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st,
                *kvx = pk + PK_UX * st, *kvy = pk + PK_UY * st;

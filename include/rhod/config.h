@@ -29,11 +29,20 @@ typedef double real;
   RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : var))
 #define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                                       \
   RHOD_PRAGMA(omp target teams distribute parallel for simd reduction(op : v1, v2))
+/* RHOD_GATHER_LOOP: a loop over particles whose work per particle varies (a gather over
+ * the support): on the device as RHOD_KERNEL_LOOP. */
+#define RHOD_GATHER_LOOP RHOD_KERNEL_LOOP
 /* On the device the particle loop is already the simd loop (one particle per lane). */
 #define RHOD_SIMD(...)
 #else
 #define RHOD_PRAGMA(x) _Pragma(#x)
 #define RHOD_KERNEL_LOOP RHOD_PRAGMA(omp parallel for schedule(static))
+/* On the host the threads take chunks of 64 particles as they come free: with mixed sizes
+ * a coarse particle's gather visits up to 4 times the neighbours of a fine one, and the
+ * sorted order groups them, so equal static shares leave threads waiting at the loop's
+ * end (perf/RESULTS.md "gather schedule"). Each particle's sums are its own, so the
+ * results do not depend on the schedule; loops with reductions stay static. */
+#define RHOD_GATHER_LOOP RHOD_PRAGMA(omp parallel for schedule(dynamic, 64))
 #define RHOD_KERNEL_LOOP_REDUCE(op, var)                                                           \
   RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : var))
 #define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                                       \
