@@ -238,26 +238,26 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
   return RHOD_OK;
 }
 
-/* After the initial criteria cascade, whose splits fall on the finer lattices of the
- * unjittered fill: each particle is jittered by the scene's jitter times its own size
- * and gets the exact initial fields of its block where it stands, as if the lattice
- * had been filled there (the split's projected pressure and m/4 are replaced, so the
- * masses match the densities). A jitter that would take a point out of its block is
- * not applied; a particle of no block (a child beyond its parent's block edge) keeps
- * its split fields. */
-static int restate_initial(rhod_sim *s) {
+/* Each particle gets the exact initial fields of its block where it stands, as if the
+ * lattice had been filled there; sizes and ids are kept. Its block is blk[id] when a
+ * table is given (the block it was made in, kept across moves), else the block at its
+ * place; a particle of no block (a child beyond its parent's block edge) keeps its
+ * fields. With jit > 0 it is first jittered by jit times its own size (after the
+ * initial criteria cascade, whose splits fall on the finer lattices of the unjittered
+ * fill; the split's projected pressure and m/4 are replaced, so the masses match the
+ * densities); a jitter that would take it out of its block is not applied. */
+static int restate_initial(rhod_sim *s, double jit, const int *blk) {
   rhod_particles *p = &s->p;
   rhod_particles_to_host(p);
   uint64_t rs = 0x5eed;
-  const double jit = s->sc->jitter;
   for (size_t k = 0; k < p->n; k++) {
     const double x = p->x[k], y = p->y[k], dx = p->dx[k];
     const double xj = x + jit * dx * jitter_rand(&rs), yj = y + jit * dx * jitter_rand(&rs);
-    const int b = fluid_block_at(s, x, y);
+    const uint64_t id = p->id[k];
+    const int b = blk ? blk[id] : fluid_block_at(s, x, y);
     if (b < 0)
       continue;
     const int moved = fluid_block_at(s, xj, yj) == b;
-    const uint64_t id = p->id[k];
     set_state(s, (unsigned)b, k, moved ? xj : x, moved ? yj : y, dx);
     p->id[k] = id;
   }
@@ -288,17 +288,8 @@ static int relax_initial(rhod_sim *s) {
     rhod_walls_guard(&s->bnd, p);
     st = rhod_sim_prepare(s, 1);
   }
-  if (st == RHOD_OK) {
-    rhod_particles_to_host(p);
-    for (size_t k = 0; k < p->n; k++) {
-      const uint64_t id = p->id[k];
-      if (blk[id] >= 0)
-        set_state(s, (unsigned)blk[id], k, p->x[k], p->y[k], p->dx[k]);
-      p->id[k] = id;
-    }
-    rhod_particles_to_device(p);
-    st = rhod_sim_prepare(s, 1);
-  }
+  if (st == RHOD_OK)
+    st = restate_initial(s, 0, blk);
   free(blk);
   return st;
 }
@@ -424,7 +415,7 @@ static int refine_initial(rhod_sim *s, char *err, size_t errlen) {
       return st;
   }
   s->apr.split_total = 0;
-  return restate_initial(s);
+  return restate_initial(s, sc->jitter, NULL);
 }
 
 void rhod_sim_free(rhod_sim *s) {
