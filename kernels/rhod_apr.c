@@ -145,7 +145,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const int32_t *CS = c->start, *CI = c->idx;
   const real *x = p->x, *y = p->y, *dx = p->dx, *ux = p->ux, *uy = p->uy, *rho = p->rho;
   const real *V = s->V, *P = s->P, *gP = s->gP;
-  const uint8_t *reg = s->reg, *near = a->near, *near2 = a->near2, *cmark = c->mark;
+  const uint8_t *reg = s->reg, *fs = s->fs, *near = a->near, *near2 = a->near2, *cmark = c->mark;
   uint8_t *mark = a->mark;
   real *sd = a->sd, *sp = a->sp;
   const int kern = s->kernel;
@@ -159,8 +159,10 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
    * the margin (HYST - 1) |threshold| (1e30 stands for none and stays far away) */
   const real dgrow = ieps * a->dx_max * (1 + SIZE_TOL);
   const real above2 = above - (HYST - 1) * fabs(above), below2 = below + (HYST - 1) * fabs(below);
-  long ncand = 0;
-  RHOD_KERNEL_LOOP_REDUCE(+, ncand)
+  /* a gather loop (its work per particle varies: the candidates and marked particles
+   * gather, the rest stop early); the candidates are counted after it, so that the count
+   * needs no reduction here */
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     const real xi = x[i], yi = y[i], dxi = dx[i], Ri = ratio * dxi, R2 = Ri * Ri;
     sd[4 * i] = gP[2 * i], sd[4 * i + 1] = gP[2 * i + 1];
@@ -187,14 +189,24 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     mark[i] = (uint8_t)m;
     if (!m && co && dxi <= dgrow && !(c3 && reg[i] != 0) && !(c4 && near2[i])) {
       /* Coalescing candidate: the criteria for the particle of size D = e dx_i at x_i
-       * (HYST above). Criterion 3 first from the per-cell free-surface flags of the
-       * region pass (conservative: whole cells), then one pass over the support e R_i:
+       * (HYST above). Criterion 3 first: no free-surface particle within HYST e R_i,
+       * looked for only where the per-cell flags of the region pass put one in reach
+       * (the cells' square reaches up to sqrt 2 times farther than the circle, which
+       * kept a band that much wider fine), then one pass over the support e R_i:
        * no particle of size dx_i/e or less (criterion 1: it would be D/e^2) and the
        * Shepard field inside the thresholds with margin (criterion 5). Criterion 2
        * needs the other candidates too (coalesce_c2): the sum of Gamma over sizes >= D
        * is kept in sp. */
       const real RD = eps * Ri, iRD = 1 / RD, iRD2 = iRD * iRD;
-      int ok = !(c3 && rhod_cells_near_mark(G, cmark, xi, yi, HYST * RD));
+      const real RH = HYST * RD, RH2 = RH * RH;
+      int ok = 1;
+      if (c3 && rhod_cells_near_mark(G, cmark, xi, yi, RH)) {
+        RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RH, j) {
+          const real rx = x[j] - xi, ry = y[j] - yi;
+          ok &= !(fs[j] && rx * rx + ry * ry < RH2);
+        }
+        RHOD_END_NEIGHBOURS
+      }
       if (ok) {
         const real self2 = rhod_Wq(kern, 0) * iRD2 * nsplit * V[i];
         const real half = ieps * dxi * (1 + SIZE_TOL), big = eps * dxi * (1 - SIZE_TOL);
@@ -207,7 +219,6 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
         sp[i] = same2;
       }
       mark[i] = ok ? 2 : 0;
-      ncand += ok;
     }
     if (!m || !(best < R2))
       continue;
@@ -272,6 +283,12 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     sd[4 * i + 2] = bx, sd[4 * i + 3] = by; /* e scaled by the aspect a */
   }
+  long ncand = 0;
+  if (co) {
+    RHOD_KERNEL_LOOP_REDUCE(+, ncand)
+    for (long i = 0; i < n; i++)
+      ncand += mark[i] == 2;
+  }
   a->groups = ncand >= 4 && coalesce_c2(a, s, p, c) >= 4 ? group(a, p, c) : 0;
   if (ncand > 0)
     drop_candidates(mark, n); /* the candidates left over */
@@ -294,7 +311,7 @@ static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
   uint8_t *mark = a->mark, *acc = a->acc;
   const int kern = s->kernel;
   const real ratio = s->ratio, eps = a->eps, nsplit = (real)a->nsplit;
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     acc[i] = 0;
     if (mark[i] != 2)
@@ -349,7 +366,7 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
   real *sp = a->sp;
   const real eps = a->eps;
   const int others = a->nsplit - 1; /* members besides the candidate: 3 or 2 */
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     sp[i] = NONE;
     if (mark[i] != 2)
@@ -407,7 +424,7 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
     grp[4 * i + 3] = others == 3 ? g3 : -1;
     sp[i] = s2;
   }
-  RHOD_KERNEL_LOOP
+  RHOD_GATHER_LOOP
   for (long j = 0; j < n; j++) {
     claim[j] = -1;
     if (mark[j] != 2)

@@ -54,7 +54,12 @@ enum {
   PK_DUX,
   PK_DUY,
   PK_RHO, /* from PK_D: pass C's */
-  PK_ROWS
+  PK_ROWS,
+  /* the region pass's rows, in pass C's (packed again by pass C after it): the
+   * free-surface flag (0 or 1) and normal */
+  PK_FS = PK_D,
+  PK_NX = PK_GPX,
+  PK_NY = PK_GPY
 };
 
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
@@ -473,6 +478,53 @@ void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p) {
  * normals of the free-surface particles in the support (i itself included when in F),
  * normalised; sigma_i = 1 on F and 1 - d_i/R_i on V, d_i the distance to the nearest
  * free-surface particle, so the projection fades out continuously across V. */
+#define RG_PARAMS                                                                                  \
+  rhod_grid G, const int32_t *CS, const uint8_t *mark, const real *x, const real *y,               \
+      const real *dx, const uint8_t *fs, const real *pk, long st, uint8_t *reg, real *nt,          \
+      real *sig, const real ratio
+#define RG_ARGS G, CS, mark, x, y, dx, fs, pk, st, reg, nt, sig, ratio
+
+/* One particle's gather of the region pass (an inlined function, specialised for the
+ * default kernel on the host as pass A's) over the packed flags and normals: the sum of
+ * W n_j over the free-surface particles j in the support (i itself included) and the
+ * nearest of them other than i (r > 0, as PAIR_OR_SKIP). */
+PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
+  const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
+  if (!rhod_cells_near_mark(G, mark, xi, yi, Ri)) {
+    reg[i] = 0, sig[i] = 0;
+    nt[2 * i] = 0, nt[2 * i + 1] = 0;
+    return;
+  }
+  const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kf = pk + PK_FS * st,
+             *knx = pk + PK_NX * st, *kny = pk + PK_NY * st;
+  const real iR = 1 / Ri;
+  real sx = 0, sy = 0, dmin2 = R2, any = 0;
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+    RHOD_SIMD(reduction(+ : sx, sy) reduction(min : dmin2) reduction(max : any))
+    for (int k = k0; k < k1; k++) {
+      const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
+      if (!(r2 < R2 && kf[k] > 0))
+        continue;
+      const real w = rhod_Wq(kern, sqrt(r2) * iR); /* W R^2: nt is normalised below */
+      sx += w * knx[k], sy += w * kny[k];
+      const real d2 = r2 > 0 ? r2 : R2;
+      dmin2 = d2 < dmin2 ? d2 : dmin2;
+      any = 1;
+    }
+  }
+  RHOD_END_ROWS
+  const real sn = sqrt(sx * sx + sy * sy);
+  if (fs[i]) {
+    reg[i] = 2, sig[i] = 1;
+  } else if (any > 0) {
+    reg[i] = 1, sig[i] = 1 - sqrt(dmin2) / Ri;
+  } else {
+    reg[i] = 0, sig[i] = 0;
+  }
+  nt[2 * i] = sn > 0 ? sx / sn : 0;
+  nt[2 * i + 1] = sn > 0 ? sy / sn : 0;
+}
+
 void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   const long n = (long)p->n;
   uint8_t *reg = s->reg;
@@ -490,42 +542,31 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   /* most particles have no free-surface particle in reach: a per-cell flag lets
    * them skip the gather */
   rhod_cells_mark(c, fs);
+  const long nt_ = (long)(p->n + p->ng), st = (long)p->cap;
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
   const uint8_t *mark = c->mark;
-  const int kern = s->kernel;
+  real *pk = s->pk;
+  /* the flags and normals in the cells' order, next to pass A's packed positions */
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt_; k++) {
+    const int j = CI[k];
+    pk[PK_FS * st + k] = fs[j] ? 1 : 0;
+    pk[PK_NX * st + k] = nrm[2 * j], pk[PK_NY * st + k] = nrm[2 * j + 1];
+  }
+  const int kern = s->kernel, generic = s->generic;
   const real ratio = s->ratio;
+  (void)generic;
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
-    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
-    if (!rhod_cells_near_mark(G, mark, xi, yi, Ri)) {
-      reg[i] = 0, sig[i] = 0;
-      nt[2 * i] = 0, nt[2 * i + 1] = 0;
-      continue;
-    }
-    real sx = 0, sy = 0, dmin2 = R2;
-    int any = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
-      if (r2 < R2 && fs[j]) {
-        const real w = rhod_W(kern, sqrt(r2), Ri);
-        sx += w * nrm[2 * j], sy += w * nrm[2 * j + 1];
-        if (j != i && r2 < dmin2)
-          dmin2 = r2;
-        any = 1;
-      }
-    }
-    RHOD_END_NEIGHBOURS
-    const real sn = sqrt(sx * sx + sy * sy);
-    if (fs[i]) {
-      reg[i] = 2, sig[i] = 1;
-    } else if (any) {
-      reg[i] = 1, sig[i] = 1 - sqrt(dmin2) / Ri;
-    } else {
-      reg[i] = 0, sig[i] = 0;
-    }
-    nt[2 * i] = sn > 0 ? sx / sn : 0;
-    nt[2 * i + 1] = sn > 0 ? sy / sn : 0;
+#ifdef RHOD_OFFLOAD
+    region_particle(i, RG_ARGS, kern);
+#else
+    if (kern == RHOD_KERNEL_WENDLAND_C2 && !generic)
+      region_particle(i, RG_ARGS, RHOD_KERNEL_WENDLAND_C2);
+    else
+      region_particle(i, RG_ARGS, kern);
+#endif
   }
 }
 
@@ -952,9 +993,13 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
   for (long k = 0; k < nt; k++)
     pk[PK_D * st + k] = aD[CI[k]];
   /* F^AD / rho of the iterate (Eq. 9, h_i = R_i / 2 as in pass C), which becomes the next
-   * iterate; |A v| / |v| estimates the largest |lambda| */
+   * iterate; |A v| / |v| estimates the largest |lambda|. The norms are summed in loops
+   * of their own, so that the gather needs no reduction (RHOD_GATHER_LOOP) */
   real nw = 0, n0 = 0;
-  RHOD_KERNEL_LOOP_REDUCE2(+, nw, n0)
+  RHOD_KERNEL_LOOP_REDUCE(+, n0)
+  for (long i = 0; i < n; i++)
+    n0 += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st,
                *kD = pk + PK_D * st;
@@ -971,10 +1016,11 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     }
     RHOD_END_ROWS
     const real ki = kad * Ri / rho[i];
-    n0 += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
     v[2 * i] = ki * fx, v[2 * i + 1] = ki * fy;
-    nw += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
   }
+  RHOD_KERNEL_LOOP_REDUCE(+, nw)
+  for (long i = 0; i < n; i++)
+    nw += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
   return n0 > 0 ? sqrt(nw / n0) : 0;
 }
 

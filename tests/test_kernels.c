@@ -751,6 +751,80 @@ static void test_free_surface_square(void) {
   cloud_free(&cl);
 }
 
+/* The free-surface region of Eq. 26 (rhod_sph_pass_region, our reading of Ref. 55 in
+ * kernels/rhod_sph.c): n~_i the W-weighted mean of the free-surface normals in the
+ * support, sigma_i = 1 - d_i / R_i with d_i the distance to the nearest free-surface
+ * particle. On a 24 x 16 lattice (R = 4 dx) the middle column k rows below the top has
+ * sigma = 1 - k/4 and n~ = (0, 1); on a disordered patch every particle's reg, sigma and
+ * n~ equal a direct sum over all pairs with the detected flags and normals. */
+static void region_check(double jitter, double *worst_sig, double *worst_n, int *wrong_reg,
+                         int *in_v) {
+  cloud cl;
+  const int NX = 24, NY = 16;
+  const double dx = 0.01;
+  cloud_make(&cl, NX, NY, dx, jitter, 7);
+  rhod_particles *p = &cl.p;
+  rhod_sph *s = &cl.s;
+  cloud_rhs(&cl);
+  CU_ASSERT_EQUAL_FATAL(p->ng, 0); /* a free patch: no ghosts */
+  const size_t n = p->n;
+  rhod_to_host(s->fs, n);
+  rhod_to_host(s->nrm, 2 * n * sizeof(real));
+  rhod_to_host(s->reg, n);
+  rhod_to_host(s->sig, n * sizeof(real));
+  rhod_to_host(s->nt, 2 * n * sizeof(real));
+  *worst_sig = *worst_n = 0, *wrong_reg = *in_v = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double R = (double)s->ratio * p->dx[i];
+    double sx = 0, sy = 0, d2 = R * R;
+    int any = 0;
+    for (size_t j = 0; j < n; j++) {
+      const double rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i], r2 = rx * rx + ry * ry;
+      if (!s->fs[j] || !(r2 < R * R))
+        continue;
+      const double w = rhod_W(s->kernel, (real)sqrt(r2), (real)R);
+      sx += w * s->nrm[2 * j], sy += w * s->nrm[2 * j + 1];
+      if (j != i && r2 < d2)
+        d2 = r2;
+      any = 1;
+    }
+    const int reg = s->fs[i] ? 2 : any;
+    const double sig = s->fs[i] ? 1 : (any ? 1 - sqrt(d2) / R : 0), sn = hypot(sx, sy);
+    *wrong_reg += s->reg[i] != reg;
+    *in_v += reg == 1;
+    *worst_sig = fmax(*worst_sig, fabs(s->sig[i] - sig));
+    if (sn > 0)
+      *worst_n = fmax(*worst_n, hypot(s->nt[2 * i] - sx / sn, s->nt[2 * i + 1] - sy / sn));
+  }
+  if (jitter == 0) { /* the middle column, k rows below the top */
+    const size_t mid = NX / 2;
+    for (int k = 0; k < 5; k++) {
+      const size_t i = (size_t)(NY - 1 - k) * NX + mid;
+      const double sig = k == 0 ? 1 : (k < 4 ? 1 - k / 4.0 : 0);
+      CU_ASSERT(fabs(s->sig[i] - sig) < TOL(1e-12, 1e-5));
+      if (k < 4) {
+        CU_ASSERT(fabs(s->nt[2 * i]) < TOL(1e-9, 1e-4));
+        CU_ASSERT(fabs(s->nt[2 * i + 1] - 1) < TOL(1e-12, 1e-5));
+      }
+    }
+  }
+  cloud_free(&cl);
+}
+
+static void test_free_surface_region(void) {
+  for (int r = 0; r < 2; r++) {
+    double ws, wn;
+    int wrong, v;
+    region_check(r ? 0.4 : 0, &ws, &wn, &wrong, &v);
+    CU_ASSERT_EQUAL(wrong, 0);
+    CU_ASSERT(v > 100);
+    CU_ASSERT(ws < TOL(1e-12, 1e-5));
+    CU_ASSERT(wn < TOL(1e-10, 1e-4));
+    printf("\n  jitter %.1f: %d in V, sigma within %.2g, n~ within %.2g ", r ? 0.4 : 0.0, v, ws,
+           wn);
+  }
+}
+
 /* PVRS (Eqs. 17, 19) and the limiter (Eq. 15) against hand-worked values. */
 static void test_pvrs_hand_values(void) {
   /* rho_L = 1000, rho_R = 1002, u_L = 1, u_R = -1, P_L = 0, P_R = 800, c0 = 20:
@@ -879,6 +953,8 @@ int main(void) {
       {"sort determinism", test_sort_determinism},
       {"renormalised gradient exact for linear fields", test_renormalised_gradient_linear},
       {"free-surface detection on a square", test_free_surface_square},
+      {"free-surface region: n~ and sigma of Eq. 26 against a direct sum",
+       test_free_surface_region},
       {"consistent viscous operator exact for quadratic fields", test_viscous_consistent},
       {"specialised gathers equal the general ones", test_specialised_gathers},
       {"coincident particles: no pair, finite fields", test_coincident_pair},
