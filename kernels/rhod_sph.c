@@ -193,6 +193,25 @@ static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   }
 }
 
+/* The particle loop of a gather whose body is FN(i, args..., kernel): the host build
+ * calls a copy in which the default kernel is a constant (unless s->generic), the device
+ * build its one copy. */
+#ifdef RHOD_OFFLOAD
+#define GATHER_BY_KERNEL(n, kern, generic, FN, ...)                                                \
+  RHOD_GATHER_LOOP                                                                                 \
+  for (long i = 0; i < (n); i++)                                                                   \
+  FN(i, __VA_ARGS__, kern)
+#else
+#define GATHER_BY_KERNEL(n, kern, generic, FN, ...)                                                \
+  RHOD_GATHER_LOOP                                                                                 \
+  for (long i = 0; i < (n); i++) {                                                                 \
+    if ((kern) == RHOD_KERNEL_WENDLAND_C2 && !(generic))                                           \
+      FN(i, __VA_ARGS__, RHOD_KERNEL_WENDLAND_C2);                                                 \
+    else                                                                                           \
+      FN(i, __VA_ARGS__, kern);                                                                    \
+  }
+#endif
+
 /* Pass A: Gamma, grad Gamma, B = L^-1, raw gradients of P and u, div u, grad C,
  * U_char; then L, the renormalised gradients (Eq. 14) and lambda, per particle. As in
  * pass C (below), the gather of one particle is an inlined function: the host build
@@ -335,17 +354,7 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const int kern = s->kernel, vcons = s->visc_cons, generic = s->generic;
   const real ratio = s->ratio;
   (void)generic;
-  RHOD_GATHER_LOOP
-  for (long i = 0; i < n; i++) {
-#ifdef RHOD_OFFLOAD
-    pass_a_particle(i, PA_ARGS, kern);
-#else
-    if (kern == RHOD_KERNEL_WENDLAND_C2 && !generic)
-      pass_a_particle(i, PA_ARGS, RHOD_KERNEL_WENDLAND_C2);
-    else
-      pass_a_particle(i, PA_ARGS, kern);
-#endif
-  }
+  GATHER_BY_KERNEL(n, kern, generic, pass_a_particle, PA_ARGS);
 }
 
 /* div u of a ghost (shared by rhod_sph_mirror_gradients and the damper probe): the
@@ -557,17 +566,7 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   const int kern = s->kernel, generic = s->generic;
   const real ratio = s->ratio;
   (void)generic;
-  RHOD_GATHER_LOOP
-  for (long i = 0; i < n; i++) {
-#ifdef RHOD_OFFLOAD
-    region_particle(i, RG_ARGS, kern);
-#else
-    if (kern == RHOD_KERNEL_WENDLAND_C2 && !generic)
-      region_particle(i, RG_ARGS, RHOD_KERNEL_WENDLAND_C2);
-    else
-      region_particle(i, RG_ARGS, kern);
-#endif
-  }
+  GATHER_BY_KERNEL(n, kern, generic, region_particle, RG_ARGS);
 }
 
 /* J_i = -R_i grad C_i (Eq. 25) projected in the free-surface region (Eq. 26), into the
