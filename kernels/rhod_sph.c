@@ -620,6 +620,17 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
   }
 }
 
+/* Pass A, the free-surface detection and the region pass, with the ghosts' mirrors: what
+ * the shifting direction (Eqs. 25-26) needs; the start of every right-hand side and of
+ * every relaxation iteration. */
+static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
+  rhod_sph_pass_a(s, p, c);
+  rhod_sph_mirror_gradients(s, p);
+  rhod_sph_pass_free_surface(s, p, c);
+  rhod_sph_mirror_surface(s, p);
+  rhod_sph_pass_region(s, p, c);
+}
+
 /* One iteration of the initial relaxation (particles.relax; our choice, docs/choices.md
  * "initial relaxation"). Paper 002 packs its initial particles with the algorithm of its
  * Ref. 16, which it does not restate; we move them instead along the scheme's own
@@ -632,11 +643,7 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
  * change of Gamma. Needs the cells and ghosts of the current positions (rhod_sim_prepare);
  * moves the fluid particles only and leaves every other field as it was. */
 void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
-  rhod_sph_pass_a(s, p, c);
-  rhod_sph_mirror_gradients(s, p);
-  rhod_sph_pass_free_surface(s, p, c);
-  rhod_sph_mirror_surface(s, p);
-  rhod_sph_pass_region(s, p, c);
+  gradients_and_surface(s, p, c);
   const long n = (long)p->n;
   real *x = p->x, *y = p->y;
   const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *ggam = s->ggam, *dx = p->dx;
@@ -881,11 +888,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
 }
 
 void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt) {
-  rhod_sph_pass_a(s, p, c);
-  rhod_sph_mirror_gradients(s, p);
-  rhod_sph_pass_free_surface(s, p, c);
-  rhod_sph_mirror_surface(s, p);
-  rhod_sph_pass_region(s, p, c);
+  gradients_and_surface(s, p, c);
   rhod_sph_pass_shift(s, p, dt);
   rhod_sph_pass_c(s, p, c);
 }
