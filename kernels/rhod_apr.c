@@ -34,6 +34,7 @@ int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   a->active = sc->refine_dynamic;
   a->dx_min = (real)dx_min;
   a->free_surface = sc->refine_free_surface;
+  a->band = (real)sc->refine_band;
   a->walls = sc->refine_walls;
   a->field = sc->refine_field;
   a->qty = sc->field_quantity;
@@ -146,6 +147,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real *x = p->x, *y = p->y, *dx = p->dx, *ux = p->ux, *uy = p->uy, *rho = p->rho;
   const real *V = s->V, *P = s->P, *gP = s->gP;
   const uint8_t *reg = s->reg, *fs = s->fs, *near = a->near, *near2 = a->near2, *cmark = c->mark;
+  const real *sig = s->sig;
   uint8_t *mark = a->mark;
   real *sd = a->sd, *sp = a->sp;
   const int kern = s->kernel;
@@ -153,6 +155,11 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real eps = a->eps, ieps = a->ieps, nsplit = (real)a->nsplit;
   const int tri = a->nsplit == 3;
   const int c3 = a->free_surface && s->fsdetect, c4 = a->walls;
+  /* criterion 3 (Sec. V B): a free-surface particle in the support, i.e. i in F u V
+   * (the region pass). With refinement.surface_band f < 1 (our option, a departure
+   * from the paper; docs/choices.md "criterion 3's reach"): i in F, or a free-surface
+   * particle nearer than f R_i, read from sigma_i = 1 - d_i/R_i on V (region pass) */
+  const real band = a->band, sband = 1 - a->band;
   const int c5 = a->field && (real)t >= a->from, dyn = a->qty == RHOD_QTY_DYNAMIC_PRESSURE;
   const real above = a->above, below = a->below;
   /* coalescing: the largest size that may merge, the thresholds of criterion 5 with
@@ -184,12 +191,13 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     if (can_split) /* a particle at dx_min is here only as a coalescing candidate */
       CRITERIA_SUMS(i, Ri, quarter, lower, same, num, den, best, ex, ey, grand);
     const real phi = num / den;
-    const int m = can_split && (grand || same < 2 * self || (c3 && reg[i] != 0) ||
-                                (c4 && near[i]) || (c5 && (phi > above || phi < below)));
+    const int in3 = c3 && (reg[i] == 2 || (reg[i] == 1 && (band >= 1 || sig[i] > sband)));
+    const int m = can_split && (grand || same < 2 * self || in3 || (c4 && near[i]) ||
+                                (c5 && (phi > above || phi < below)));
     mark[i] = (uint8_t)m;
-    if (!m && co && dxi <= dgrow && !(c3 && reg[i] != 0) && !(c4 && near2[i])) {
+    if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i])) {
       /* Coalescing candidate: the criteria for the particle of size D = e dx_i at x_i
-       * (HYST above). Criterion 3 first: no free-surface particle within HYST e R_i,
+       * (HYST above). Criterion 3 first: no free-surface particle within HYST f e R_i,
        * looked for only where the per-cell flags of the region pass put one in reach
        * (the cells' square reaches up to sqrt 2 times farther than the circle, which
        * kept a band that much wider fine), then one pass over the support e R_i:
@@ -198,7 +206,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
        * needs the other candidates too (coalesce_c2): the sum of Gamma over sizes >= D
        * is kept in sp. */
       const real RD = eps * Ri, iRD = 1 / RD, iRD2 = iRD * iRD;
-      const real RH = HYST * RD, RH2 = RH * RH;
+      const real RH = HYST * band * RD, RH2 = RH * RH;
       int ok = 1;
       if (c3 && rhod_cells_near_mark(G, cmark, xi, yi, RH)) {
         RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RH, j) {

@@ -158,6 +158,7 @@ typedef struct {
   y_region *regions;
   unsigned n_regions;
   bool *dynamic, *free_surface, *walls, *coalesce;
+  double *surface_band;
   int *pattern;
   y_refine_field *field;
 } y_refinement;
@@ -436,6 +437,7 @@ static const cyaml_schema_field_t f_refinement[] = {
                                CYAML_UNLIMITED),
     BOOL_OPT("dynamic", y_refinement, dynamic),
     BOOL_OPT("free_surface", y_refinement, free_surface),
+    NUM_OPT("surface_band", y_refinement, surface_band),
     BOOL_OPT("walls", y_refinement, walls),
     BOOL_OPT("coalesce", y_refinement, coalesce),
     CYAML_FIELD_MAPPING_PTR("field", OPT | CYAML_FLAG_FLOW, y_refinement, field, f_refine_field),
@@ -1265,6 +1267,13 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
   s->pattern = r && r->pattern ? (rhod_pattern)*r->pattern : RHOD_PATTERN_SQUARE;
   s->refine_dynamic = s->levels > 1 && opt_bool(r ? r->dynamic : NULL, 1);
   s->refine_free_surface = opt_bool(r ? r->free_surface : NULL, 0);
+  s->refine_band = opt(r ? r->surface_band : NULL, 1);
+  if (!(s->refine_band >= 0.5 && s->refine_band <= 1))
+    return fail(c, "refinement.surface_band",
+                "must be in [0.5, 1] (a fraction of the particle's support radius), got %g",
+                s->refine_band);
+  if (r && r->surface_band && !s->refine_free_surface)
+    return fail(c, "refinement.surface_band", "needs criterion 3 (refinement.free_surface: true)");
   s->refine_walls = opt_bool(r ? r->walls : NULL, 0);
   s->refine_coalesce = opt_bool(r ? r->coalesce : NULL, 0);
   if (r && r->n_regions && s->pattern != RHOD_PATTERN_SQUARE)
@@ -1797,6 +1806,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
   }
   tb_bool(&t, m, "dynamic", s->refine_dynamic);
   tb_bool(&t, m, "free_surface", s->refine_free_surface);
+  if (s->refine_free_surface)
+    tb_num(&t, m, "surface_band", s->refine_band);
   tb_bool(&t, m, "walls", s->refine_walls);
   tb_bool(&t, m, "coalesce", s->refine_coalesce);
   if (s->refine_field) {

@@ -300,6 +300,61 @@ static void split_conservation(const char *pattern) {
 static void test_split_conservation(void) { split_conservation("square"); }
 static void test_split_conservation_triangle(void) { split_conservation("triangle"); }
 
+/* Criterion 3 against a direct sum: on the tank's jittered lattice (levels 2, no t = 0
+ * split), the particles the criteria mark are exactly those in F or with a free-surface
+ * particle nearer than f R_i (refinement.surface_band f; 1 is the paper's "within the
+ * support"), counted away from the side walls (whose ghosts the direct sum leaves
+ * out). Returns the marked ones; *wrong counts disagreements. */
+static long band_marks(double f, long *wrong) {
+  run r;
+  char yaml[1024];
+  snprintf(yaml, sizeof yaml,
+           "time: {end: 1, output_every: 1}\n"
+           "particles: {dx: 0.01, jitter: 0.2}\n"
+           "physics: {c0: 10, gravity: [0, -9.81]}\n"
+           "fluid:\n"
+           "  - rect: {min: [0, 0], max: [0.3, 0.12]}\n"
+           "    pressure: hydrostatic\n"
+           "walls:\n"
+           "  - rect: {min: [0, 0], max: [0.3, 0.2]}\n"
+           "refinement: {levels: 2, dynamic: false, free_surface: true, surface_band: %g}\n",
+           f);
+  CU_ASSERT_FATAL(run_open(&r, "surface_band", yaml));
+  rhod_sim *s = r.sim;
+  rhod_sph_rhs(&s->sph, &s->p, &s->cells, (real)s->dt);
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&s->apr, &s->sph, &s->p, &s->cells, &s->bnd, 0, 0), RHOD_OK);
+  rhod_to_host(s->apr.mark, s->p.n);
+  rhod_snapshot_view v;
+  rhod_sim_fetch(s, &v); /* the same positions: the right-hand side moves nothing */
+  long marked = 0;
+  *wrong = 0;
+  for (size_t i = 0; i < v.n; i++) {
+    const real Ri = s->sph.ratio * v.size[i], fR = (real)f * Ri;
+    if (!(v.x[i] > Ri && v.x[i] < (real)0.3 - Ri))
+      continue;
+    int want = v.fs[i] != 0;
+    for (size_t j = 0; j < v.n && !want; j++) {
+      const real rx = v.x[j] - v.x[i], ry = v.y[j] - v.y[i];
+      want = j != i && v.fs[j] && rx * rx + ry * ry < fR * fR;
+    }
+    marked += s->apr.mark[i] != 0;
+    *wrong += (s->apr.mark[i] != 0) != want;
+  }
+  run_close(&r);
+  return marked;
+}
+
+static void test_surface_band(void) {
+  long wrong1, wrong6;
+  const long m1 = band_marks(1, &wrong1), m6 = band_marks(0.6, &wrong6);
+  printf("\n  marked away from the side walls: %ld within R_i (wrong %ld), %ld within 0.6 R_i "
+         "(wrong %ld) ",
+         m1, wrong1, m6, wrong6);
+  CU_ASSERT_EQUAL(wrong1, 0);
+  CU_ASSERT_EQUAL(wrong6, 0);
+  CU_ASSERT(m6 > 20 && m1 > m6 + 20); /* the jittered surface: 95 against 66 */
+}
+
 /* Children are kept off the walls: a jittered lattice (parents a quarter to three
  * quarters of dx from the walls) split everywhere (criterion 5 with no bound). The
  * pattern's score sees the walls' ghosts, yet without the push the nearest child stands
@@ -1393,6 +1448,7 @@ int main(void) {
       {"mixed-size neighbour search = brute force", test_mixed_size_neighbours},
       {"a split round conserves mass and momenta", test_split_conservation},
       {"... also with the 1 -> 3 triangle", test_split_conservation_triangle},
+      {"criterion 3 within f R_i (surface_band 1 and 0.6) against a direct sum", test_surface_band},
       {"split geometry and children's state", test_split_geometry},
       {"split pattern on a strained lattice", test_split_strained_lattice},
       {"the 1 -> 3 triangle: geometry and children's state", test_split_triangle},

@@ -322,6 +322,8 @@ static const struct {
     {"refine_free_surface_no_detection.yaml", 14, "refinement.free_surface",
      "needs the free-surface detection"},
     {"refine_coalesce_static.yaml", 13, "refinement.coalesce", "needs dynamic refinement"},
+    {"refine_surface_band_range.yaml", 13, "refinement.surface_band", "must be in [0.5, 1]"},
+    {"refine_surface_band_no_criterion.yaml", 12, "refinement.surface_band", "needs criterion 3"},
     {"refine_pattern_unknown.yaml", 12, "refinement.pattern", "hexagon"},
     {"refine_triangle_regions.yaml", 14, "refinement.regions", "need refinement.pattern: square"},
     {"viscosity_unknown.yaml", 12, "scheme.viscosity", "invalid value 'morris'"},

@@ -22,6 +22,7 @@ typedef struct {
   int active;       /* dynamic refinement on */
   real dx_min;      /* no particle is split below this size */
   int free_surface; /* criterion 3 */
+  real band;        /* criterion 3's reach over R_i (refinement.surface_band; 1: the paper) */
   int walls;        /* criterion 4 */
   int field;        /* criterion 5 */
   rhod_quantity qty;

@@ -193,13 +193,14 @@ typedef struct {
   rhod_pattern pattern; /* refinement.pattern, default square (e = 2) */
   rhod_region *regions; /* refinement.regions: initial nested levels */
   unsigned n_regions;
-  int refine_dynamic;              /* refinement.dynamic: split by the criteria during the run
-                                      (criteria 1 and 2 always), default true when levels > 1 */
-  int refine_free_surface;         /* refinement.free_surface: criterion 3, default false */
-  int refine_walls;                /* refinement.walls: criterion 4, default false */
-  int refine_field;                /* refinement.field given: criterion 5 */
-  int refine_coalesce;             /* refinement.coalesce: merge back where no criterion
-                                      holds any more, default false */
+  int refine_dynamic;      /* refinement.dynamic: split by the criteria during the run
+                              (criteria 1 and 2 always), default true when levels > 1 */
+  int refine_free_surface; /* refinement.free_surface: criterion 3, default false */
+  double refine_band;      /* refinement.surface_band: criterion 3's reach over R_i, default 1 */
+  int refine_walls;        /* refinement.walls: criterion 4, default false */
+  int refine_field;        /* refinement.field given: criterion 5 */
+  int refine_coalesce;     /* refinement.coalesce: merge back where no criterion
+                              holds any more, default false */
   rhod_quantity field_quantity;    /* refinement.field.quantity */
   double field_above, field_below; /* thresholds (+-HUGE_VAL when absent) */
   double field_from;               /* refinement.field.from [s], default 0 */
