@@ -231,6 +231,21 @@ static int ids_unique(const rhod_snapshot_view *v, uint64_t next_id) {
   "walls:\n"                                                                                       \
   "  - rect: {min: [0, 0], max: [0.2, 0.2]}\n"
 
+/* A tank at rest (0.3 x 0.12 m of water, dx 0.01 m, two levels); PARTICLES is the
+ * particles mapping, EXTRA more keys of the refinement block */
+#define REST_TANK_P(PARTICLES, extra)                                                              \
+  "time: {end: 1, output_every: 1}\n"                                                              \
+  "particles: " PARTICLES "\n"                                                                     \
+  "physics: {c0: 10, gravity: [0, -9.81]}\n"                                                       \
+  "fluid:\n"                                                                                       \
+  "  - rect: {min: [0, 0], max: [0.3, 0.12]}\n"                                                    \
+  "    pressure: hydrostatic\n"                                                                    \
+  "walls:\n"                                                                                       \
+  "  - rect: {min: [0, 0], max: [0.3, 0.2]}\n"                                                     \
+  "refinement:\n"                                                                                  \
+  "  levels: 2\n" extra
+#define REST_TANK(extra) REST_TANK_P("{dx: 0.01}", extra)
+
 /* One refinement round of a run, as its last RK stage does it: the right-hand side,
  * the criteria, the split. Returns how many were split. */
 static long split_round(run *r) {
@@ -309,15 +324,8 @@ static long band_marks(double f, long *wrong) {
   run r;
   char yaml[1024];
   snprintf(yaml, sizeof yaml,
-           "time: {end: 1, output_every: 1}\n"
-           "particles: {dx: 0.01, jitter: 0.2}\n"
-           "physics: {c0: 10, gravity: [0, -9.81]}\n"
-           "fluid:\n"
-           "  - rect: {min: [0, 0], max: [0.3, 0.12]}\n"
-           "    pressure: hydrostatic\n"
-           "walls:\n"
-           "  - rect: {min: [0, 0], max: [0.3, 0.2]}\n"
-           "refinement: {levels: 2, dynamic: false, free_surface: true, surface_band: %g}\n",
+           REST_TANK_P("{dx: 0.01, jitter: 0.2}", "  dynamic: false\n  free_surface: true\n"
+                                                  "  surface_band: %g\n"),
            f);
   CU_ASSERT_FATAL(run_open(&r, "surface_band", yaml));
   rhod_sim *s = r.sim;
@@ -1036,23 +1044,6 @@ static void coalesce_groups(rhod_pattern pattern) {
 static void test_coalesce_groups(void) { coalesce_groups(RHOD_PATTERN_SQUARE); }
 static void test_coalesce_groups_triangle(void) { coalesce_groups(RHOD_PATTERN_TRIANGLE); }
 
-/* A tank at rest with a refined block (level 1) in the bulk and no criterion asking
- * for it: with coalescing the block merges back from its edges (the merged particle
- * needs coarse neighbours, criterion 2 with margin), no merged particle is split
- * again, and mass stays. Without coalescing nothing changes. With criterion 3 the
- * free-surface band made at t = 0 stays (hysteresis). */
-#define REST_TANK(extra)                                                                           \
-  "time: {end: 1, output_every: 1}\n"                                                              \
-  "particles: {dx: 0.01}\n"                                                                        \
-  "physics: {c0: 10, gravity: [0, -9.81]}\n"                                                       \
-  "fluid:\n"                                                                                       \
-  "  - rect: {min: [0, 0], max: [0.3, 0.12]}\n"                                                    \
-  "    pressure: hydrostatic\n"                                                                    \
-  "walls:\n"                                                                                       \
-  "  - rect: {min: [0, 0], max: [0.3, 0.2]}\n"                                                     \
-  "refinement:\n"                                                                                  \
-  "  levels: 2\n" extra
-
 static long count_fine(const rhod_snapshot_view *v, double dx) {
   long k = 0;
   for (size_t i = 0; i < v->n; i++)
@@ -1060,6 +1051,11 @@ static long count_fine(const rhod_snapshot_view *v, double dx) {
   return k;
 }
 
+/* A tank at rest with a refined block (level 1) in the bulk and no criterion asking
+ * for it: with coalescing the block merges back from its edges (the merged particle
+ * needs coarse neighbours, criterion 2 with margin), no merged particle is split
+ * again, and mass stays. Without coalescing nothing changes. With criterion 3 the
+ * free-surface band made at t = 0 stays (hysteresis). */
 static void test_coalesce_run(void) {
   const char *kinds[3] = {
       REST_TANK("  coalesce: true\n"
@@ -1173,17 +1169,8 @@ static void test_initial_relaxation(void) {
   for (int relax = 0; relax < 2; relax++) {
     char yaml[1024];
     snprintf(yaml, sizeof yaml,
-             "time: {end: 1, output_every: 1}\n"
-             "particles: {dx: 0.01, jitter: 0.3, relax: %d}\n"
-             "physics: {c0: 10, gravity: [0, -9.81]}\n"
-             "fluid:\n"
-             "  - rect: {min: [0, 0], max: [0.3, 0.12]}\n"
-             "    pressure: hydrostatic\n"
-             "walls:\n"
-             "  - rect: {min: [0, 0], max: [0.3, 0.2]}\n"
-             "refinement:\n"
-             "  levels: 2\n"
-             "  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n",
+             REST_TANK_P("{dx: 0.01, jitter: 0.3, relax: %d}",
+                         "  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n"),
              relax ? 100 : 0);
     run r;
     CU_ASSERT_FATAL(run_open(&r, relax ? "relax1" : "relax0", yaml));
