@@ -1267,11 +1267,15 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
   s->pattern = r && r->pattern ? (rhod_pattern)*r->pattern : RHOD_PATTERN_SQUARE;
   s->refine_dynamic = s->levels > 1 && opt_bool(r ? r->dynamic : NULL, 1);
   s->refine_free_surface = opt_bool(r ? r->free_surface : NULL, 0);
+  /* criterion 3's reach, no lower than 1/e (e the size ratio of adjacent levels): a
+   * free-surface particle's support then holds only the finest size */
   s->refine_band = opt(r ? r->surface_band : NULL, 1);
-  if (!(s->refine_band >= 0.5 && s->refine_band <= 1))
+  const double band_min = 1 / rhod_pattern_ratio(s->pattern);
+  if (!(s->refine_band >= band_min * (1 - 1e-12) && s->refine_band <= 1))
     return fail(c, "refinement.surface_band",
-                "must be in [0.5, 1] (a fraction of the particle's support radius), got %g",
-                s->refine_band);
+                "must be in [%.4g, 1] (a fraction of the particle's support radius, at least "
+                "1 over the size ratio of adjacent levels), got %g",
+                band_min, s->refine_band);
   if (r && r->surface_band && !s->refine_free_surface)
     return fail(c, "refinement.surface_band", "needs criterion 3 (refinement.free_surface: true)");
   s->refine_walls = opt_bool(r ? r->walls : NULL, 0);

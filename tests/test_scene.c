@@ -323,6 +323,7 @@ static const struct {
      "needs the free-surface detection"},
     {"refine_coalesce_static.yaml", 13, "refinement.coalesce", "needs dynamic refinement"},
     {"refine_surface_band_range.yaml", 13, "refinement.surface_band", "must be in [0.5, 1]"},
+    {"refine_surface_band_triangle.yaml", 14, "refinement.surface_band", "must be in [0.5774, 1]"},
     {"refine_surface_band_no_criterion.yaml", 12, "refinement.surface_band", "needs criterion 3"},
     {"refine_pattern_unknown.yaml", 12, "refinement.pattern", "hexagon"},
     {"refine_triangle_regions.yaml", 14, "refinement.regions", "need refinement.pattern: square"},
