@@ -486,7 +486,9 @@ void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p) {
  * quantities paper 002 takes from its Ref. 55: n~_i = the W-weighted mean of the
  * normals of the free-surface particles in the support (i itself included when in F),
  * normalised; sigma_i = 1 on F and 1 - d_i/R_i on V, d_i the distance to the nearest
- * free-surface particle, so the projection fades out continuously across V. */
+ * free-surface particle, so the projection fades out continuously across V.
+ * refinement.surface_band (rhod_apr_mark) reads d_i / R_i back as 1 - sigma_i: a change
+ * of sigma's definition must change it too (test_apr's direct sum fails otherwise). */
 #define RG_PARAMS                                                                                  \
   rhod_grid G, const int32_t *CS, const uint8_t *mark, const real *x, const real *y,               \
       const real *dx, const uint8_t *fs, const real *pk, long st, uint8_t *reg, real *nt,          \
