@@ -895,6 +895,57 @@ void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt) {
   rhod_sph_pass_c(s, p, c);
 }
 
+/* sum m (x - a) x acc over the fluid */
+static real torque_of_acc(const rhod_sph *s, const rhod_particles *p, real ax, real ay) {
+  const long n = (long)p->n;
+  const real *x = p->x, *y = p->y, *m = p->m, *acc = s->acc;
+  real t = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, t)
+  for (long i = 0; i < n; i++)
+    t += m[i] * ((x[i] - ax) * acc[2 * i + 1] - (y[i] - ay) * acc[2 * i]);
+  return t;
+}
+
+void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt, real ax,
+                            real ay, double out[RHOD_TQ_TERMS]) {
+  rhod_sph_rhs(s, p, c, dt);
+  const long n = (long)p->n;
+  const real *x = p->x, *y = p->y, *m = p->m, *ux = p->ux, *uy = p->uy, *du = s->du;
+  const real gx = s->gx, gy = s->gy;
+  real mo = 0, bo = 0;
+  RHOD_KERNEL_LOOP_REDUCE2(+, mo, bo)
+  for (long i = 0; i < n; i++) {
+    mo += m[i] * (du[2 * i] * uy[i] - du[2 * i + 1] * ux[i]);
+    bo += m[i] * ((x[i] - ax) * gy - (y[i] - ay) * gx);
+  }
+  /* pass C with the terms switched on one after the other; viscosity before Theta^u,
+   * which Eq. 3 leaves out where there is viscosity (alpha_mu) */
+  const rhod_sph keep = *s;
+  s->riemann = 0, s->mu = 0, s->visc_cons = 0, s->damper = 0, s->shifting = 0;
+  rhod_sph_pass_c(s, p, c);
+  const real t0 = torque_of_acc(s, p, ax, ay); /* pressure and body force */
+  s->mu = keep.mu, s->visc_cons = keep.visc_cons;
+  rhod_sph_pass_c(s, p, c);
+  const real t1 = torque_of_acc(s, p, ax, ay);
+  s->riemann = keep.riemann;
+  rhod_sph_pass_c(s, p, c);
+  const real t2 = torque_of_acc(s, p, ax, ay);
+  s->damper = keep.damper;
+  rhod_sph_pass_c(s, p, c);
+  const real t3 = torque_of_acc(s, p, ax, ay);
+  s->shifting = keep.shifting;
+  rhod_sph_pass_c(s, p, c); /* the full right-hand side again */
+  const real t4 = torque_of_acc(s, p, ax, ay);
+  *s = keep;
+  out[RHOD_TQ_PRESSURE] = t0 - bo;
+  out[RHOD_TQ_VISCOUS] = t1 - t0;
+  out[RHOD_TQ_RIEMANN] = t2 - t1;
+  out[RHOD_TQ_DAMPER] = t3 - t2;
+  out[RHOD_TQ_SHIFTING] = t4 - t3;
+  out[RHOD_TQ_BODY] = bo;
+  out[RHOD_TQ_MOTION] = mo;
+}
+
 /* The damper step limit (our choice; paper 002 does not discuss it; docs/choices.md
  * "Damper step limit"). Eq. 9 with D from Eq. 5 is linear in u: F^AD / rho = A u, a bulk
  * viscosity alpha c0 h integrated explicitly, whose eigenvalues are real and negative.

@@ -138,6 +138,7 @@ typedef struct {
   y_probe_sum *mass, *momentum;
   y_probe_angular *angular_momentum;
   y_probe_sum *elastic_energy;
+  y_probe_angular *torque_budget;
 } y_probe;
 
 typedef struct {
@@ -251,10 +252,10 @@ static const cyaml_strval_t pattern_names[] = {
     {"triangle", RHOD_PATTERN_TRIANGLE},
 };
 static const char *const probe_kind_names[] = {
-    "pressure", "kinetic_energy", "potential_energy", "front",
-    "mass",     "momentum",       "angular_momentum", "elastic_energy",
+    "pressure", "kinetic_energy",   "potential_energy", "front",         "mass",
+    "momentum", "angular_momentum", "elastic_energy",   "torque_budget",
 };
-#define N_PROBE_KINDS 8
+#define N_PROBE_KINDS 9
 
 static const cyaml_schema_field_t f_time[] = {
     NUM("end", y_time, end),
@@ -393,6 +394,7 @@ static const cyaml_schema_field_t f_probe[] = {
     PROBE("momentum", momentum, f_probe_sum),
     PROBE("angular_momentum", angular_momentum, f_probe_angular),
     PROBE("elastic_energy", elastic_energy, f_probe_sum),
+    PROBE("torque_budget", torque_budget, f_probe_angular),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_probe = {
@@ -1170,8 +1172,8 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
   char base[64];
   snprintf(base, sizeof base, "probes.list.%u", i);
   const void *given[N_PROBE_KINDS] = {
-      y->pressure, y->kinetic_energy, y->potential_energy, y->front,
-      y->mass,     y->momentum,       y->angular_momentum, y->elastic_energy};
+      y->pressure, y->kinetic_energy,   y->potential_energy, y->front,        y->mass,
+      y->momentum, y->angular_momentum, y->elastic_energy,   y->torque_budget};
   int first = -1;
   for (int k = 0; k < N_PROBE_KINDS; k++) {
     if (!given[k])
@@ -1233,6 +1235,11 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
   case RHOD_PROBE_ELASTIC_ENERGY:
     name = y->elastic_energy->name;
     break;
+  case RHOD_PROBE_TORQUE_BUDGET:
+    name = y->torque_budget->name;
+    if (y->torque_budget->at)
+      memcpy(p->at, y->torque_budget->at, sizeof p->at);
+    break;
   }
   if (!name)
     name = probe_kind_names[first];
@@ -1245,15 +1252,31 @@ static int load_probe(lctx *c, const y_probe *y, unsigned i, rhod_probe *p, char
   return p->name ? RHOD_OK : fail_oom(c);
 }
 
-/* CSV column names of a probe: momentum has two. */
-static unsigned probe_columns(const rhod_probe *p, char cols[2][NAME_MAX_LEN + 3]) {
-  if (p->kind == RHOD_PROBE_MOMENTUM) {
-    snprintf(cols[0], sizeof cols[0], "%s_x", p->name);
-    snprintf(cols[1], sizeof cols[1], "%s_y", p->name);
-    return 2;
-  }
-  snprintf(cols[0], sizeof cols[0], "%s", p->name);
-  return 1;
+/* the torque budget's columns, in the order of rhod_sph_torque_budget's terms */
+static const char *const torque_suffixes[RHOD_PROBE_MAX_COLUMNS] = {
+    "_pressure", "_viscous", "_riemann", "_damper", "_shifting", "_body", "_motion"};
+
+unsigned rhod_probe_ncolumns(rhod_probe_kind kind) {
+  return kind == RHOD_PROBE_MOMENTUM        ? 2
+         : kind == RHOD_PROBE_TORQUE_BUDGET ? RHOD_PROBE_MAX_COLUMNS
+                                            : 1;
+}
+
+const char *rhod_probe_suffix(rhod_probe_kind kind, unsigned column) {
+  if (kind == RHOD_PROBE_MOMENTUM)
+    return column ? "_y" : "_x";
+  if (kind == RHOD_PROBE_TORQUE_BUDGET && column < RHOD_PROBE_MAX_COLUMNS)
+    return torque_suffixes[column];
+  return "";
+}
+
+/* CSV column names of a probe */
+static unsigned probe_columns(const rhod_probe *p,
+                              char cols[RHOD_PROBE_MAX_COLUMNS][NAME_MAX_LEN + 16]) {
+  const unsigned nc = rhod_probe_ncolumns(p->kind);
+  for (unsigned a = 0; a < nc; a++)
+    snprintf(cols[a], sizeof cols[a], "%s%s", p->name, rhod_probe_suffix(p->kind, a));
+  return nc;
 }
 
 /* refinement: levels, initial regions and the switchable criteria of Sec. V B. */
@@ -1523,7 +1546,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
         return fail(c, path, "[%g, %g] lies outside the domain", at[0], at[1]);
       }
     }
-    char mine[2][NAME_MAX_LEN + 3], other[2][NAME_MAX_LEN + 3];
+    char mine[RHOD_PROBE_MAX_COLUMNS][NAME_MAX_LEN + 16],
+        other[RHOD_PROBE_MAX_COLUMNS][NAME_MAX_LEN + 16];
     unsigned nm = probe_columns(&s->probes[i], mine);
     for (unsigned a = 0; a < nm; a++)
       if (strcmp(mine[a], "t") == 0) {
@@ -1789,11 +1813,12 @@ static ry_node *scene_tree(const rhod_scene *s) {
   for (unsigned i = 0; i < s->n_probes; i++) {
     const rhod_probe *p = &s->probes[i];
     e = tb_coll(&t, m, NULL, RY_MAP, 0);
-    unsigned kind = (unsigned)p->kind < 7 ? (unsigned)p->kind : 0;
+    unsigned kind = (unsigned)p->kind < N_PROBE_KINDS ? (unsigned)p->kind : 0;
     ry_node *b = tb_coll(&t, e, probe_kind_names[kind], RY_MAP, 1);
     if (p->name)
       tb_word(&t, b, "name", p->name);
-    if (p->kind == RHOD_PROBE_PRESSURE || p->kind == RHOD_PROBE_ANGULAR_MOMENTUM)
+    if (p->kind == RHOD_PROBE_PRESSURE || p->kind == RHOD_PROBE_ANGULAR_MOMENTUM ||
+        p->kind == RHOD_PROBE_TORQUE_BUDGET)
       tb_vec(&t, b, "at", p->at);
     if (p->kind == RHOD_PROBE_FRONT)
       tb_vec(&t, b, "direction", p->direction);

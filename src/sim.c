@@ -595,15 +595,11 @@ unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MA
   unsigned k = 0;
   for (unsigned i = 0; i < sc->n_probes && k < max; i++) {
     const rhod_probe *pr = &sc->probes[i];
-    const char *nm = pr->name; /* the loader names every probe */
-    if (pr->kind == RHOD_PROBE_MOMENTUM) {
-      for (int a = 0; a < 2 && k < max; a++) {
-        snprintf(buf[k], RHOD_PROBE_NAME_MAX, "%s_%c", nm, a ? 'y' : 'x');
-        names[k] = buf[k];
-        k++;
-      }
-    } else {
-      names[k++] = nm;
+    const unsigned nc = rhod_probe_ncolumns(pr->kind);
+    for (unsigned a = 0; a < nc && k < max; a++, k++) {
+      /* the loader names every probe */
+      snprintf(buf[k], RHOD_PROBE_NAME_MAX, "%s%s", pr->name, rhod_probe_suffix(pr->kind, a));
+      names[k] = buf[k];
     }
   }
   return k;
@@ -711,6 +707,13 @@ void rhod_probe_values(rhod_sim *s, double *values) {
       for (long j = 0; j < n; j++)
         a += m[j] * ((x[j] - ax) * uy[j] - (y[j] - ay) * ux[j]);
       values[k++] = a;
+      break;
+    }
+    case RHOD_PROBE_TORQUE_BUDGET: {
+      double tq[RHOD_TQ_TERMS];
+      rhod_sph_torque_budget(h, p, &s->cells, (real)s->dt, ax, ay, tq);
+      for (int a = 0; a < RHOD_TQ_TERMS; a++)
+        values[k++] = tq[a];
       break;
     }
     }

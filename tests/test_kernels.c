@@ -523,6 +523,73 @@ static void test_shifting_switch(void) {
          big_sum, big_sw, nren, acc_changed);
 }
 
+/* The torque budget (rhod_sph_torque_budget, the torque_budget probe) on a free,
+ * jittered 20 x 20 patch turning about its centre and strained, with a pressure field. Its columns
+ * add up to the torque of the full right-hand side plus sum m du x u. With Eq. 6 and
+ * Theta^u in their conservative forms everywhere (thresholds above any Gamma) every pair
+ * force is central and antisymmetric at one size, so the pressure, Riemann, damper and
+ * (Eq. 10) viscous columns vanish to round-off, while the renormalised Eq. 6 of the
+ * default leaves a torque: paper 002 Sec. VI B, "momenta are not formally conserved". */
+static void tq_patch(double gth, double mu, double g, double out[RHOD_TQ_TERMS], double *full,
+                     double *body) {
+  cloud cl;
+  const double dx = 0.01, c = 0.1;
+  cloud_make(&cl, 20, 20, dx, 0.3, 41);
+  rhod_particles *p = &cl.p;
+  rhod_sph *s = &cl.s;
+  s->gamma_th = (real)gth, s->theta_th = (real)gth, s->mu = (real)mu, s->gy = (real)-g;
+  for (size_t i = 0; i < p->n; i++) {
+    const double X = p->x[i] - c, Y = p->y[i] - c;
+    /* a rotation plus a strain, so that pi_ij of Eq. 10 and U_char (hence du) are not 0 */
+    p->ux[i] = (real)(-2 * Y + 0.5 * X), p->uy[i] = (real)(2 * X - 0.5 * Y);
+    p->rho[i] = (real)(1000 * (1 + 0.002 * (1 - (X * X + Y * Y) / (c * c)) + 1e-4 * X / c));
+    p->m[i] = (real)(p->rho[i] * dx * dx);
+  }
+  cloud_sync(&cl);
+  rhod_sph_fill_state(s, p);
+  rhod_cells_build(&cl.c, p->x, p->y, p->n);
+  rhod_sph_torque_budget(s, p, &cl.c, (real)1e-4, (real)c, (real)c, out);
+  rhod_to_host(s->acc, 2 * p->n * sizeof(real));
+  rhod_to_host(s->du, 2 * p->n * sizeof(real));
+  *full = 0, *body = 0;
+  for (size_t i = 0; i < p->n; i++)
+    *body -= p->m[i] * (p->x[i] - c) * g;
+  for (size_t i = 0; i < p->n; i++)
+    *full += p->m[i] * ((p->x[i] - c) * s->acc[2 * i + 1] - (p->y[i] - c) * s->acc[2 * i] +
+                        s->du[2 * i] * p->uy[i] - s->du[2 * i + 1] * p->ux[i]);
+  cloud_free(&cl);
+}
+
+static void test_torque_budget(void) {
+  double ren[RHOD_TQ_TERMS], con[RHOD_TQ_TERMS], vis[RHOD_TQ_TERMS], fr, fc, fv, br, bc, bv;
+  tq_patch(0.85, 0, 0, ren, &fr, &br); /* the default thresholds: Eq. 6 renormalised inside */
+  tq_patch(2, 0, 9.81, con, &fc, &bc); /* conservative everywhere, with gravity */
+  tq_patch(2, 1, 0, vis, &fv, &bv);    /* the same with viscosity (Eq. 10), no gravity */
+  double sr = 0, sc = 0, sv = 0;
+  for (int a = 0; a < RHOD_TQ_TERMS; a++)
+    sr += ren[a], sc += con[a], sv += vis[a];
+  const double scale = fabs(ren[RHOD_TQ_PRESSURE]);
+  CU_ASSERT(scale > 0);
+  CU_ASSERT(fabs(sr - fr) < TOL(1e-9, 1e-3) * scale); /* the columns add up */
+  CU_ASSERT(fabs(sc - fc) < TOL(1e-9, 1e-3) * scale);
+  CU_ASSERT(fabs(sv - fv) < TOL(1e-9, 1e-3) * scale);
+  const double eps = TOL(1e-9, 1e-3) * scale;
+  CU_ASSERT(fabs(con[RHOD_TQ_PRESSURE]) < eps);
+  CU_ASSERT(fabs(con[RHOD_TQ_RIEMANN]) < eps);
+  CU_ASSERT(fabs(con[RHOD_TQ_DAMPER]) < eps);
+  CU_ASSERT(fabs(vis[RHOD_TQ_VISCOUS]) < eps);
+  CU_ASSERT(con[RHOD_TQ_VISCOUS] == 0 && vis[RHOD_TQ_RIEMANN] == 0); /* alpha_mu of Eq. 3 */
+  CU_ASSERT(ren[RHOD_TQ_BODY] == 0 && bc != 0);
+  CU_ASSERT(fabs(con[RHOD_TQ_BODY] - bc) < TOL(1e-12, 1e-5) * fabs(bc));
+  /* not zero: Theta^u where it is renormalised (Eq. 24), and the shifting */
+  CU_ASSERT(fabs(ren[RHOD_TQ_RIEMANN]) > eps && fabs(ren[RHOD_TQ_SHIFTING]) > eps);
+  CU_ASSERT(fabs(vis[RHOD_TQ_SHIFTING]) > eps);
+  printf("\n  torque: renormalised Eq. 6 %.3g, conservative %.3g, Theta^u %.3g / %.3g, "
+         "Eq. 10 %.3g ",
+         ren[RHOD_TQ_PRESSURE], con[RHOD_TQ_PRESSURE], ren[RHOD_TQ_RIEMANN], con[RHOD_TQ_RIEMANN],
+         vis[RHOD_TQ_VISCOUS]);
+}
+
 /* Our choice for a pair at zero distance (docs/choices.md): it has no n_ij and is
  * skipped, so two particles on top of each other (a particle lying on a wall and its
  * own mirror ghost, say) leave every field finite. */
@@ -961,6 +1028,7 @@ int main(void) {
       {"tensile control: P_j - P_i where P_i < 0, conservative, off the surface",
        test_tensile_control},
       {"shifting switch: Eq. 4 difference form where Eq. 6 is renormalised", test_shifting_switch},
+      {"torque budget: adds up, zero for the conservative forms", test_torque_budget},
       {"PVRS and limiter hand values", test_pvrs_hand_values},
       {"RK4 fourth order, RK2 second order", test_rk_order},
       {"wall-crossing guard, corners included", test_walls_guard},

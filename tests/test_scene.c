@@ -95,7 +95,7 @@ static void test_full_scene(void) {
   CU_ASSERT_FALSE(s->walls[1].fluid_inside);
 
   CLOSE(s->probe_every, 0.001);
-  CU_ASSERT_EQUAL_FATAL(s->n_probes, 7);
+  CU_ASSERT_EQUAL_FATAL(s->n_probes, 8);
   CU_ASSERT_EQUAL(s->probes[0].kind, RHOD_PROBE_PRESSURE);
   CU_ASSERT_STRING_EQUAL(s->probes[0].name, "P1");
   CLOSE(s->probes[0].at[0], 4.0);
@@ -111,6 +111,9 @@ static void test_full_scene(void) {
   CU_ASSERT_EQUAL(s->probes[6].kind, RHOD_PROBE_ANGULAR_MOMENTUM);
   CU_ASSERT_STRING_EQUAL(s->probes[6].name, "angular_momentum");
   CLOSE(s->probes[6].at[1], 0.5);
+  CU_ASSERT_EQUAL(s->probes[7].kind, RHOD_PROBE_TORQUE_BUDGET);
+  CU_ASSERT_STRING_EQUAL(s->probes[7].name, "tq");
+  CLOSE(s->probes[7].at[1], 0.25);
 
   CU_ASSERT_EQUAL(s->picture_field, RHOD_FIELD_VELOCITY);
   CU_ASSERT_EQUAL(s->picture_width, 1024);

@@ -69,13 +69,19 @@ typedef enum {
   RHOD_PROBE_MASS,             /* sum m [kg/m] */
   RHOD_PROBE_MOMENTUM,         /* sum m u, two columns name_x, name_y [kg/s] */
   RHOD_PROBE_ANGULAR_MOMENTUM, /* sum m (x - at) x u [kg m/s] */
-  RHOD_PROBE_ELASTIC_ENERGY    /* sum m e(rho), e the compression energy of Eq. 2 [J/m] */
+  RHOD_PROBE_ELASTIC_ENERGY,   /* sum m e(rho), e the compression energy of Eq. 2 [J/m] */
+  RHOD_PROBE_TORQUE_BUDGET     /* d/dt sum m (x - at) x u term by term, seven columns
+                                  (rhod_sph_torque_budget) [kg m/s^2] */
 } rhod_probe_kind;
+/* CSV columns of a probe kind: name + suffix for each (one column: the suffix ""). */
+#define RHOD_PROBE_MAX_COLUMNS 7
+unsigned rhod_probe_ncolumns(rhod_probe_kind kind);
+const char *rhod_probe_suffix(rhod_probe_kind kind, unsigned column);
 
 typedef struct {
   rhod_probe_kind kind;
   char *name;          /* CSV column name; default: the kind's name */
-  double at[2];        /* PRESSURE: the point; ANGULAR_MOMENTUM: the origin */
+  double at[2];        /* PRESSURE: the point; ANGULAR_MOMENTUM, TORQUE_BUDGET: the origin */
   double direction[2]; /* FRONT: unit direction, default [1, 0] */
 } rhod_probe;
 

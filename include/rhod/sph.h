@@ -86,6 +86,29 @@ void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c);
  * the packed rows of the gathers, which the next pass A and pass C pack again. */
 real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 
+/* The angular-momentum budget of one right-hand side (the torque_budget probe): the
+ * torque about (ax, ay) of each term of the momentum equation (Eq. 3), sum m (x - a) x
+ * a_term, switched on one after the other in pass C (so each is its own difference):
+ * RHOD_TQ_PRESSURE (Eq. 6), RHOD_TQ_VISCOUS (Eq. 10 or the consistent Laplacian),
+ * RHOD_TQ_RIEMANN (Theta^u, Eq. 24; zero with viscosity), RHOD_TQ_DAMPER (Eq. 9),
+ * RHOD_TQ_SHIFTING (the Eq. 4 momentum term), RHOD_TQ_BODY (the body force), and
+ * RHOD_TQ_MOTION = sum m du x u, the change of sum m x x u that comes from moving the
+ * particles at u + du (Eq. 3's dx/dt) instead of u. Their sum is dLz/dt of the fluid.
+ * Runs a full right-hand side first (the neighbour structure must be built), then
+ * pass C five times; it leaves the full right-hand side in drho, acc and vel. */
+enum {
+  RHOD_TQ_PRESSURE,
+  RHOD_TQ_VISCOUS,
+  RHOD_TQ_RIEMANN,
+  RHOD_TQ_DAMPER,
+  RHOD_TQ_SHIFTING,
+  RHOD_TQ_BODY,
+  RHOD_TQ_MOTION,
+  RHOD_TQ_TERMS
+};
+void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt, real ax,
+                            real ay, double out[RHOD_TQ_TERMS]);
+
 /* Time step of Eq. 11 over the fluid, and with adlim no more than RHOD_AD_TARGET /
  * ad_lambda. */
 real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p);
