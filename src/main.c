@@ -112,8 +112,8 @@ typedef struct {
   size_t *snap_n;
   double *probe_vals;
   unsigned nprobe_cols;
-  const char *probe_names[64];
-  char probe_buf[64][RHOD_PROBE_NAME_MAX];
+  const char *probe_names[RHOD_PROBE_COLUMNS_TOTAL];
+  char probe_buf[RHOD_PROBE_COLUMNS_TOTAL][RHOD_PROBE_NAME_MAX];
   char where[256];
   /* checkpoints */
   const char *scene_arg;
@@ -395,7 +395,7 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     }
   }
   rhod_scene_params(c.sc, &c.params);
-  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, 64);
+  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, RHOD_PROBE_COLUMNS_TOTAL);
   c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
   snprintf(path, sizeof path, "%s/probes.csv", out);
   if (resume_out)

@@ -1536,6 +1536,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       return fail_oom(c);
     s->n_probes = pr->n_list;
   }
+  unsigned ncols = 0;
   for (unsigned i = 0; i < s->n_probes; i++) {
     char kind_path[96];
     TRY(load_probe(c, &pr->list[i], i, &s->probes[i], kind_path, sizeof kind_path));
@@ -1549,6 +1550,11 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     char mine[RHOD_PROBE_MAX_COLUMNS][NAME_MAX_LEN + 16],
         other[RHOD_PROBE_MAX_COLUMNS][NAME_MAX_LEN + 16];
     unsigned nm = probe_columns(&s->probes[i], mine);
+    if ((ncols += nm) > RHOD_PROBE_COLUMNS_TOTAL)
+      return fail(c, "probes.list",
+                  "%u or more columns, at most %d (momentum gives 2, "
+                  "torque_budget 7)",
+                  ncols, RHOD_PROBE_COLUMNS_TOTAL);
     for (unsigned a = 0; a < nm; a++)
       if (strcmp(mine[a], "t") == 0) {
         snprintf(path, sizeof path, "%s.name", kind_path);

@@ -317,6 +317,7 @@ static const struct {
     {"front_zero_direction.yaml", 12, "probes.list.0.front.direction", "must not be zero"},
     {"duplicate_probe_names.yaml", 13, "probes.list.1.pressure.name", "duplicate probe column"},
     {"probe_two_kinds.yaml", 13, "probes.list.0.momentum", "one probe per entry"},
+    {"probe_columns_total.yaml", 12, "probes.list", "at most 64"},
     {"picture_width.yaml", 12, "output.picture.width", "[64, 8192]"},
     {"range_order.yaml", 12, "output.picture.range", "must be below high"},
     {"refine_criterion_one_level.yaml", 11, "refinement.levels", "need at least 2 levels"},

@@ -75,6 +75,8 @@ typedef enum {
 } rhod_probe_kind;
 /* CSV columns of a probe kind: name + suffix for each (one column: the suffix ""). */
 #define RHOD_PROBE_MAX_COLUMNS 7
+/* columns of all the probes of a scene together, at most (the loader refuses more) */
+#define RHOD_PROBE_COLUMNS_TOTAL 64
 unsigned rhod_probe_ncolumns(rhod_probe_kind kind);
 const char *rhod_probe_suffix(rhod_probe_kind kind, unsigned column);
 
