@@ -64,4 +64,15 @@ for s in snaps:
                 sys.exit(f"{s}: {k} not finite")
 PY
 
+# the torque_budget probe reads the state without changing the run: its scene without
+# the probe gives the same other columns, bit for bit
+TQ=$SRC/tests/scenes/run/rotating_torque.yaml
+expect 0 "run with the torque budget" -- "$RHOD" run "$TQ" -o "$T/tq"
+grep -v torque_budget "$TQ" >"$T/notq.yaml"
+expect 0 "the same without it" -- "$RHOD" run "$T/notq.yaml" -o "$T/notq"
+check "torque budget columns" -- bash -c "head -1 '$T/tq/probes.csv' | grep -q \
+  '^t,ke,Lz,tq_pressure,tq_viscous,tq_riemann,tq_damper,tq_shifting,tq_body,tq_motion\$'"
+check "the probe leaves the run alone" -- cmp -s <(cut -d, -f1-3 "$T/tq/probes.csv") \
+  <(cut -d, -f1-3 "$T/notq/probes.csv")
+
 summary cli
