@@ -549,6 +549,7 @@ static void tq_patch(double gth, double mu, double g, double out[RHOD_TQ_TERMS],
   rhod_sph_fill_state(s, p);
   rhod_cells_build(&cl.c, p->x, p->y, p->n);
   rhod_sph_torque_budget(s, p, &cl.c, (real)1e-4, (real)c, (real)c, out);
+  rhod_sph_rhs(s, p, &cl.c, (real)1e-4); /* the full right-hand side, on its own */
   rhod_to_host(s->acc, 2 * p->n * sizeof(real));
   rhod_to_host(s->du, 2 * p->n * sizeof(real));
   /* the body force's torque, and the sum of its magnitudes (the scale of its round-off) */

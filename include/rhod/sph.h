@@ -95,7 +95,8 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
  * RHOD_TQ_MOTION = sum m du x u, the change of sum m x x u that comes from moving the
  * particles at u + du (Eq. 3's dx/dt) instead of u. Their sum is dLz/dt of the fluid.
  * Runs a full right-hand side first (the neighbour structure must be built), then
- * pass C five times; it leaves the full right-hand side in drho, acc and vel. */
+ * pass C four times; drho, acc and vel are left as the last of these (scratch, which
+ * the next right-hand side overwrites). */
 enum {
   RHOD_TQ_PRESSURE,
   RHOD_TQ_VISCOUS,
