@@ -349,14 +349,8 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
         snprintf(err, sizeof err, "out of memory for ghost particles");
     }
   }
-  if (st != RHOD_OK) {
-    fprintf(stderr, "rhod: %s\n", err);
-    rhod_sim_free(&c.sim);
-    rhod_scene_free(c.sc);
-    rhod_checkpoint_free(&ck);
-    return st;
-  }
-  st = check_output_dir(out, err, sizeof err);
+  if (st == RHOD_OK)
+    st = check_output_dir(out, err, sizeof err);
   if (st != RHOD_OK) {
     fprintf(stderr, "rhod: %s\n", err);
     rhod_sim_free(&c.sim);
@@ -369,6 +363,9 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
   g_log = fopen(path, resume_out ? "a" : "w");
   if (!g_log) {
     fprintf(stderr, "rhod: %s: cannot write: %s\n", path, strerror(errno));
+    rhod_sim_free(&c.sim);
+    rhod_scene_free(c.sc);
+    rhod_checkpoint_free(&ck);
     return RHOD_ERR_OUTPUT;
   }
   rhod_where(c.where, sizeof c.where);
