@@ -1552,9 +1552,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     unsigned nm = probe_columns(&s->probes[i], mine);
     if ((ncols += nm) > RHOD_PROBE_COLUMNS_TOTAL)
       return fail(c, "probes.list",
-                  "%u or more columns, at most %d (momentum gives 2, "
-                  "torque_budget 7)",
-                  ncols, RHOD_PROBE_COLUMNS_TOTAL);
+                  "%u or more columns, at most %d (momentum gives 2, torque_budget %d)", ncols,
+                  RHOD_PROBE_COLUMNS_TOTAL, RHOD_PROBE_MAX_COLUMNS);
     for (unsigned a = 0; a < nm; a++)
       if (strcmp(mine[a], "t") == 0) {
         snprintf(path, sizeof path, "%s.name", kind_path);

@@ -710,6 +710,8 @@ void rhod_probe_values(rhod_sim *s, double *values) {
       break;
     }
     case RHOD_PROBE_TORQUE_BUDGET: {
+      /* one value per column the loader and rhod_probe_columns count for this kind */
+      _Static_assert(RHOD_TQ_TERMS == RHOD_PROBE_MAX_COLUMNS, "torque_budget columns");
       double tq[RHOD_TQ_TERMS];
       rhod_sph_torque_budget(h, p, &s->cells, (real)s->dt, ax, ay, tq);
       for (int a = 0; a < RHOD_TQ_TERMS; a++)
