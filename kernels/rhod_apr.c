@@ -29,6 +29,38 @@
 #define Q_MIN ((real)0.5)
 #define NONE ((real)1e30)
 
+/* (sa, sb): child k's offset along the pattern's direction e and across it (Sec. V A,
+ * Fig. 5; Appendix for the triangle): the corners of the rectangle of half-sides ha
+ * along e and hb across, or (tri) of the equilateral triangle of circumradius rt with
+ * corner 0 along e. A macro, not a function: two outputs would be pointer outputs,
+ * which GCC 12 nvptx puts in the warp-shared frame (tests/offload_frames.sh). */
+#define CHILD_OFFSET(tri, k, ha, hb, rt, sa, sb)                                                   \
+  const real sa = (tri) ? ((k) == 0 ? (rt) : -(real)0.5 * (rt)) : (((k)&1) ? (ha) : -(ha));        \
+  const real sb = (tri) ? ((k) == 0 ? 0 : ((k) == 1 ? S32 : -S32) * (rt)) : (((k)&2) ? (hb) : -(hb))
+#define S32 ((real)0.86602540378443865) /* sqrt(3)/2 */
+
+/* Our choice (the paper is silent): where a child would land behind a wall, or nearer
+ * to it than keep (a quarter of its size), the whole pattern moves along the wall
+ * normal until every child stands at least keep in front; (shx, shy), zero on entry,
+ * gets that move. A child behind a wall has no ghosts and was seen to blow up the dam
+ * break within steps. Moving the children one by one put two of them on one point, with
+ * one velocity, where a parent stood within a quarter of a child's size of a wall (the
+ * four-level dam break stopped at t = 0.70 s when such a pair reached 96 m/s); moved
+ * together they keep the pattern's spacing. Each child's move carries to the next; a
+ * second round settles a corner whose walls are not at right angles. Walls farther
+ * behind a child than back are not its walls (the far side of a thin body). Over the
+ * locals seg, nseg, circ, ncirc (the walls of rhod_boundary). */
+#define PATTERN_SHIFT(tri, xi, yi, ex, ey, ha, hb, rt, keep, back, shx, shy)                       \
+  for (int r_ = 0; r_ < 2; r_++)                                                                   \
+    for (int k_ = 0; k_ < ((tri) ? 3 : 4); k_++) {                                                 \
+      CHILD_OFFSET(tri, k_, ha, hb, rt, sa_, sb_);                                                 \
+      const real ex_ = (ex), ey_ = (ey);                                                           \
+      const real cx_ = (xi) + sa_ * ex_ - sb_ * ey_ + (shx);                                       \
+      const real cy_ = (yi) + sa_ * ey_ + sb_ * ex_ + (shy);                                       \
+      const rhod_point q_ = rhod_walls_keep_off(seg, nseg, circ, ncirc, cx_, cy_, keep, back);     \
+      (shx) += q_.x - cx_, (shy) += q_.y - cy_;                                                    \
+    }
+
 int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   memset(a, 0, sizeof *a);
   a->active = sc->refine_dynamic;
@@ -146,6 +178,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const int32_t *CS = c->start, *CI = c->idx;
   const real *x = p->x, *y = p->y, *dx = p->dx, *ux = p->ux, *uy = p->uy, *rho = p->rho;
   const real *V = s->V, *P = s->P, *gP = s->gP;
+  const real *seg = b->seg, *circ = b->circ;
+  const int nseg = b->nseg, ncirc = b->ncirc;
   const uint8_t *reg = s->reg, *fs = s->fs, *near = a->near, *near2 = a->near2, *cmark = c->mark;
   const real *sig = s->sig;
   uint8_t *mark = a->mark;
@@ -237,8 +271,9 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
      * nearest-neighbour direction turned by 0, 15, ... 75 degrees and a in 1.25^-4 ..
      * 1.25^4 (a and 1/a cover the other half turn). A pattern scores the smaller of
      * its sibling spacing, min(a, 1/a) dx_i/2, and, for every neighbour j within
-     * 2 dx_i (ghosts too, so a wall counts), twice the distance by which each child
-     * stays on i's side of the i-j interface point x_i + w_i (x_j - x_i) of Eq. 12:
+     * 2 dx_i (ghosts too, so a wall counts), twice the distance by which each child,
+     * moved off the walls as the split will move it (PATTERN_SHIFT), stays on i's side
+     * of the i-j interface point x_i + w_i (x_j - x_i) of Eq. 12:
      * the distance to j's children if j splits alike. The best score wins; ties keep
      * the square aligned with the nearest neighbour (the paper's pattern), which is
      * what a regular lattice gets. On a strained lattice (rows squeezed to 0.4 dx by
@@ -256,7 +291,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
      * Only marked particles pay for the passes. */
     const real e0 = sqrt(best), h = (real)0.25 * dxi, reach = 2 * dxi, reach2 = reach * reach;
     const real c15 = (real)0.96592582628906829, s15 = (real)0.25881904510252076;
-    const real s32 = (real)0.86602540378443865, rt = dxi / 3;
+    const real s32 = S32, rt = dxi / 3, keep = (real)0.25 * dxi * ieps, back = (real)0.5 * dxi;
     const int turns = tri ? 8 : 6, aspects = tri ? 1 : 9;
     real sbest = (real)-1e30, fx = ex / e0, fy = ey / e0, bx = fx, by = fy;
     for (int k = 0; k < turns; k++) {
@@ -266,6 +301,9 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
         up = (q & 1) ? up * (real)1.25 : up;
         const real a = (q & 1) || q == 0 ? up : 1 / up, ha = h * a, hb = h / a;
         real score = tri ? s32 * 2 * rt : 2 * (a < 1 ? ha : hb);
+        /* the pattern where the split will put it: moved off the walls */
+        real shx = 0, shy = 0;
+        PATTERN_SHIFT(tri, xi, yi, fx, fy, ha, hb, rt, keep, back, shx, shy);
         RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
           const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
           if (j != i && r2 < reach2) {
@@ -277,7 +315,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
              * (-1/2, +-sqrt(3)/2) */
             const real en = (fx * rx + fy * ry) / r, pn = (fx * ry - fy * rx) / r;
             const real tn = -(real)0.5 * en + s32 * fabs(pn);
-            const real on = tri ? rt * (en > tn ? en : tn) : ha * fabs(en) + hb * fabs(pn);
+            const real on = (tri ? rt * (en > tn ? en : tn) : ha * fabs(en) + hb * fabs(pn)) +
+                            (shx * rx + shy * ry) / r;
             const real sj = 2 * (wr - on);
             score = sj < score ? sj : score;
           }
@@ -493,7 +532,8 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   const real *sd = a->sd;
   const uint64_t id0 = p->next_id;
   const real c2 = s->c0 * s->c0, ic2 = 1 / c2, rho0 = s->rho0;
-  const real ieps = a->ieps, inn = 1 / (real)nsplit, s32 = (real)0.86602540378443865;
+  const real ieps = a->ieps, inn = 1 / (real)nsplit;
+  const int tri = nsplit == 3;
   const real *seg = b->seg, *circ = b->circ;
   const int nseg = b->nseg, ncirc = b->ncirc;
   RHOD_KERNEL_LOOP
@@ -512,27 +552,19 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
     const real ex = sd[4 * i + 2] / a, ey = sd[4 * i + 3] / a;
     const real ha = (real)0.25 * dxi * a, hb = (real)0.25 * dxi / a, rt = dxi / 3;
     const real dc = dxi * ieps; /* the children's size */
+    /* the children stay a quarter of their size in front of the walls (PATTERN_SHIFT) */
+    real shx = 0, shy = 0;
+    PATTERN_SHIFT(tri, xi, yi, ex, ey, ha, hb, rt, (real)0.25 * dc, (real)0.5 * dxi, shx, shy);
     for (int k = 0; k < nsplit; k++) {
-      /* (sa, sb): the child's offset along e and across it */
-      const real sa = nsplit == 3 ? (k == 0 ? rt : -(real)0.5 * rt) : ((k & 1) ? ha : -ha);
-      const real sb =
-          nsplit == 3 ? (k == 0 ? 0 : (k == 1 ? s32 : -s32) * rt) : ((k & 2) ? hb : -hb);
-      /* Our choice (the paper is silent): a child that would land behind a wall, or
-       * nearer to it than a quarter of its size, is moved along the wall normal to a
-       * quarter of its size in front (half would push both children of a parent
-       * squeezed against the wall onto one line); a child behind a wall has no ghosts
-       * and was seen to blow up in the dam break within steps. Its pressure is
-       * projected at the moved place. */
-      const rhod_point q =
-          rhod_walls_keep_off(seg, nseg, circ, ncirc, xi + sa * ex - sb * ey,
-                              yi + sa * ey + sb * ex, (real)0.25 * dc, (real)0.5 * dxi);
-      const real ox = q.x - xi, oy = q.y - yi;
+      CHILD_OFFSET(tri, k, ha, hb, rt, sa, sb);
+      const real cx = xi + sa * ex - sb * ey + shx, cy = yi + sa * ey + sb * ex + shy;
+      const real ox = cx - xi, oy = cy - yi;
       const long c = k == 0 ? i : n + cnt[i] + k - 1;
       /* Sec. V A: P_c = P_i + <grad P>^L_i . (x_c - x_i), rho_c from Eq. 2,
        * m_c = m_i/N so that V_c = (V_i rho_i / N) / rho_c (N = 4; 3 for the triangle,
        * the Appendix's "modified consistently") */
       const real Pc = Pi + gx * ox + gy * oy;
-      x[c] = q.x, y[c] = q.y;
+      x[c] = cx, y[c] = cy;
       rho[c] = rho0 + Pc * ic2;
       m[c] = inn * mi;
       dx[c] = dc;

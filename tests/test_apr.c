@@ -417,6 +417,53 @@ static void test_split_keeps_off_walls(void) {
   run_close(&r);
 }
 
+/* A parent almost on a wall: the lattice's column next to the left wall is moved to
+ * 0.02 dx from it, and every particle splits. The pattern's score sees the wall's
+ * ghosts, so it flattens against the wall, and both children on a row across the wall
+ * then stand within a quarter of their size of it. The push must keep them apart:
+ * moved one by one, they landed on one point (seen in the four-level dam break, which
+ * stopped 20 steps later when such a pair reached 96 m/s). Every particle must keep
+ * a tenth of its size from every other and a quarter from the walls. */
+static void test_split_near_wall_keeps_spacing(void) {
+  run r;
+  CU_ASSERT_FATAL(run_open(&r, "nearwall",
+                           "time: {end: 1, output_every: 1}\n"
+                           "particles: {dx: 0.01}\n"
+                           "physics: {c0: 10, gravity: [0, -9.81]}\n"
+                           "fluid:\n"
+                           "  - rect: {min: [0, 0], max: [0.1, 0.05]}\n"
+                           "    pressure: hydrostatic\n"
+                           "walls:\n"
+                           "  - rect: {min: [0, 0], max: [0.1, 0.1]}\n"
+                           "refinement: {levels: 2, dynamic: false,\n"
+                           "             field: {quantity: pressure, below: 1e30}}\n"));
+  rhod_particles *p = &r.sim->p;
+  rhod_to_host(p->x, p->n * sizeof(real));
+  long moved = 0;
+  for (size_t i = 0; i < p->n; i++)
+    if (p->x[i] < 0.01) /* the column at x = dx/2 */
+      p->x[i] = (real)0.0002, moved++;
+  rhod_to_device(p->x, p->n * sizeof(real));
+  CU_ASSERT_EQUAL_FATAL(moved, 5);
+  CU_ASSERT_EQUAL_FATAL(rhod_sim_prepare(r.sim, 1), RHOD_OK);
+  const long n0 = (long)p->n;
+  CU_ASSERT_EQUAL_FATAL(split_round(&r), n0);
+  rhod_snapshot_view v;
+  rhod_sim_fetch(r.sim, &v);
+  CU_ASSERT_EQUAL_FATAL(v.n, (size_t)(4 * n0));
+  double nearest = HUGE_VAL, wall = HUGE_VAL;
+  for (size_t i = 0; i < v.n; i++) {
+    wall = fmin(wall, rhod_wall_distance(&r.sim->bnd, v.x[i], v.y[i]) / v.size[i]);
+    for (size_t j = i + 1; j < v.n; j++)
+      nearest = fmin(nearest, hypot(v.x[j] - v.x[i], v.y[j] - v.y[i]) / v.size[i]);
+  }
+  printf("\nnear a wall: nearest pair %.3f, nearest wall %.3f of the children's size\n", nearest,
+         wall);
+  CU_ASSERT(nearest > 0.1);
+  CU_ASSERT(wall > 0.25 - TOL(1e-9));
+  run_close(&r);
+}
+
 /* Free-surface flags of a snapshot: a tank at rest, jittered, in one resolution, in
  * three levels laid out in horizontal bands (coarse at the bottom, fine at the top,
  * as the free-surface criterion lays them out), and refined by criterion 3 at t = 0.
@@ -1440,6 +1487,7 @@ int main(void) {
       {"split pattern on a strained lattice", test_split_strained_lattice},
       {"the 1 -> 3 triangle: geometry and children's state", test_split_triangle},
       {"split children are kept off the walls", test_split_keeps_off_walls},
+      {"... and apart, from a parent almost on a wall", test_split_near_wall_keeps_spacing},
       {"dx_min is never crossed", test_dx_min_never_crossed},
       {"criteria 1 and 2", test_criteria_1_2},
       {"coalescing groups and conservation", test_coalesce_groups},
