@@ -363,6 +363,18 @@ static void test_surface_band(void) {
   CU_ASSERT(m6 > 20 && m1 > m6 + 20); /* the jittered surface: 95 against 66 */
 }
 
+/* A tank in a box of walls, every particle split at once (criterion 5 with no bound);
+ * PARTICLES: the particles line of the scene. */
+#define SPLIT_ALL_SCENE(PARTICLES)                                                                 \
+  "time: {end: 1, output_every: 1}\n" PARTICLES "physics: {c0: 10, gravity: [0, -9.81]}\n"         \
+  "fluid:\n"                                                                                       \
+  "  - rect: {min: [0, 0], max: [0.1, 0.05]}\n"                                                    \
+  "    pressure: hydrostatic\n"                                                                    \
+  "walls:\n"                                                                                       \
+  "  - rect: {min: [0, 0], max: [0.1, 0.1]}\n"                                                     \
+  "refinement: {levels: 2, dynamic: false,\n"                                                      \
+  "             field: {quantity: pressure, below: 1e30}}\n"
+
 /* Children are kept off the walls: a jittered lattice (parents a quarter to three
  * quarters of dx from the walls) split everywhere (criterion 5 with no bound). The
  * pattern's score sees the walls' ghosts, yet without the push the nearest child stands
@@ -371,17 +383,7 @@ static void test_surface_band(void) {
  * must be kept. */
 static void test_split_keeps_off_walls(void) {
   run r;
-  CU_ASSERT_FATAL(run_open(&r, "walls",
-                           "time: {end: 1, output_every: 1}\n"
-                           "particles: {dx: 0.01, jitter: 0.5}\n"
-                           "physics: {c0: 10, gravity: [0, -9.81]}\n"
-                           "fluid:\n"
-                           "  - rect: {min: [0, 0], max: [0.1, 0.05]}\n"
-                           "    pressure: hydrostatic\n"
-                           "walls:\n"
-                           "  - rect: {min: [0, 0], max: [0.1, 0.1]}\n"
-                           "refinement: {levels: 2, dynamic: false,\n"
-                           "             field: {quantity: pressure, below: 1e30}}\n"));
+  CU_ASSERT_FATAL(run_open(&r, "walls", SPLIT_ALL_SCENE("particles: {dx: 0.01, jitter: 0.5}\n")));
   rhod_snapshot_view v;
   rhod_sim_fetch(r.sim, &v);
   const size_t n0 = v.n;
@@ -426,17 +428,7 @@ static void test_split_keeps_off_walls(void) {
  * a tenth of its size from every other and a quarter from the walls. */
 static void test_split_near_wall_keeps_spacing(void) {
   run r;
-  CU_ASSERT_FATAL(run_open(&r, "nearwall",
-                           "time: {end: 1, output_every: 1}\n"
-                           "particles: {dx: 0.01}\n"
-                           "physics: {c0: 10, gravity: [0, -9.81]}\n"
-                           "fluid:\n"
-                           "  - rect: {min: [0, 0], max: [0.1, 0.05]}\n"
-                           "    pressure: hydrostatic\n"
-                           "walls:\n"
-                           "  - rect: {min: [0, 0], max: [0.1, 0.1]}\n"
-                           "refinement: {levels: 2, dynamic: false,\n"
-                           "             field: {quantity: pressure, below: 1e30}}\n"));
+  CU_ASSERT_FATAL(run_open(&r, "nearwall", SPLIT_ALL_SCENE("particles: {dx: 0.01}\n")));
   rhod_particles *p = &r.sim->p;
   rhod_to_host(p->x, p->n * sizeof(real));
   long moved = 0;
