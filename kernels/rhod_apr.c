@@ -44,12 +44,12 @@
  * normal until every child stands at least keep in front; (shx, shy), zero on entry,
  * gets that move. A child behind a wall has no ghosts and was seen to blow up the dam
  * break within steps. Moving the children one by one put two of them on one point, with
- * one velocity, where a parent stood within a quarter of a child's size of a wall (the
- * four-level dam break stopped at t = 0.70 s when such a pair reached 96 m/s); moved
- * together they keep the pattern's spacing. Each child's move carries to the next; a
- * second round settles a corner whose walls are not at right angles. Walls farther
- * behind a child than back are not its walls (the far side of a thin body). Over the
- * locals seg, nseg, circ, ncirc (the walls of rhod_boundary). */
+ * one velocity, where a parent stood within a quarter of a child's size of a wall (two
+ * such pairs in the four-level dam break; cases/dam_break_lobovsky/RESULTS.md "Twin
+ * children at a wall"); moved together they keep the pattern's spacing. Each child's
+ * move carries to the next; a second round settles a corner whose walls are not at
+ * right angles. Walls farther behind a child than back are not its walls (the far side
+ * of a thin body). Over the locals seg, nseg, circ, ncirc (the walls of rhod_boundary). */
 #define PATTERN_SHIFT(tri, xi, yi, ex, ey, ha, hb, rt, keep, back, shx, shy)                       \
   for (int r_ = 0; r_ < 2; r_++)                                                                   \
     for (int k_ = 0; k_ < ((tri) ? 3 : 4); k_++) {                                                 \
@@ -291,7 +291,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
      * Only marked particles pay for the passes. */
     const real e0 = sqrt(best), h = (real)0.25 * dxi, reach = 2 * dxi, reach2 = reach * reach;
     const real c15 = (real)0.96592582628906829, s15 = (real)0.25881904510252076;
-    const real s32 = S32, rt = dxi / 3, keep = (real)0.25 * dxi * ieps, back = (real)0.5 * dxi;
+    const real s32 = S32, rt = dxi / 3, keep = (real)0.25 * (dxi * ieps), back = (real)0.5 * dxi;
     const int turns = tri ? 8 : 6, aspects = tri ? 1 : 9;
     real sbest = (real)-1e30, fx = ex / e0, fy = ey / e0, bx = fx, by = fy;
     for (int k = 0; k < turns; k++) {

@@ -423,9 +423,9 @@ static void test_split_keeps_off_walls(void) {
  * 0.02 dx from it, and every particle splits. The pattern's score sees the wall's
  * ghosts, so it flattens against the wall, and both children on a row across the wall
  * then stand within a quarter of their size of it. The push must keep them apart:
- * moved one by one, they landed on one point (seen in the four-level dam break, which
- * stopped 20 steps later when such a pair reached 96 m/s). Every particle must keep
- * a tenth of its size from every other and a quarter from the walls. */
+ * moved one by one, they landed on one point (two such pairs in the four-level dam
+ * break). Every particle must keep a tenth of its size from every other and a quarter
+ * from the walls. */
 static void test_split_near_wall_keeps_spacing(void) {
   run r;
   CU_ASSERT_FATAL(run_open(&r, "nearwall", SPLIT_ALL_SCENE("particles: {dx: 0.01}\n")));
