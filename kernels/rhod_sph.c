@@ -81,6 +81,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   s->tic = sc->tensile_control;
   s->shsw = sc->shifting_switch;
   s->adlim = sc->acoustic_damper && sc->damper_step_limit;
+  s->stlim = sc->stiffness_limit && sc->integrator == RHOD_INTEGRATOR_RK4;
   s->alpha_ad = (real)sc->alpha_ad;
   s->sa = (real)sc->shift_a;
   s->sb = (real)sc->shift_b;
@@ -953,7 +954,7 @@ void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real 
  * largest |lambda| is measured: one power iteration per step on an iterate carried with
  * the particles (and checkpointed, so that a resumed run takes the same steps), plus a
  * small reproducible perturbation that lets a new stiff mode grow into it, and
- * rhod_sph_dt keeps dt |lambda| <= RHOD_AD_TARGET. A measures what the run integrates:
+ * rhod_sph_dt keeps dt |lambda| <= RHOD_DT_TARGET. A measures what the run integrates:
  * the ghosts carry the iterate mapped as the velocity (T v) and the divergence as pass A's
  * mirror (the source's, or the trace of the mapped renormalised gradient). */
 
@@ -1097,8 +1098,13 @@ real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {
   }
   /* the damper step limit (rhod_sph_damper_probe) */
   if (s->adlim && s->ad_lambda > 0) {
-    const real d4 = (real)RHOD_AD_TARGET / s->ad_lambda;
+    const real d4 = (real)RHOD_DT_TARGET / s->ad_lambda;
     dt = d4 < dt ? d4 : dt;
+  }
+  /* the stiffness limit (rhod_sim_step, rhod_rk_stiffness) */
+  if (s->stlim && s->st_lambda > 0) {
+    const real d5 = (real)RHOD_DT_TARGET / s->st_lambda;
+    dt = d5 < dt ? d5 : dt;
   }
   return dt;
 }

@@ -28,8 +28,9 @@ typedef struct {
 } bench_scene;
 
 /* Scheme switches from the command line: any of noshift, nodamper, nolimit (the damper
- * without its step limit), nofs, noriemann, norecon, visc (mu such that Re = 100 for the unit box),
- * visc_consistent (the same with scheme.viscosity: consistent). An unknown word is an error. */
+ * without its step limit), nostiff (no stiffness limit), nofs, noriemann, norecon, visc (mu such
+ * that Re = 100 for the unit box), visc_consistent (the same with scheme.viscosity: consistent). An
+ * unknown word is an error. */
 static inline int bench_switches(rhod_scene *sc, int argc, char **argv, int first) {
   for (int k = first; k < argc; k++) {
     if (!strcmp(argv[k], "noshift"))
@@ -38,6 +39,8 @@ static inline int bench_switches(rhod_scene *sc, int argc, char **argv, int firs
       sc->acoustic_damper = 0;
     else if (!strcmp(argv[k], "nolimit"))
       sc->damper_step_limit = 0;
+    else if (!strcmp(argv[k], "nostiff"))
+      sc->stiffness_limit = 0;
     else if (!strcmp(argv[k], "nofs"))
       sc->free_surface = 0;
     else if (!strcmp(argv[k], "noriemann"))
@@ -67,7 +70,7 @@ static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch, 
   sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = 1;
   sc->free_surface = 1;
   sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
-  sc->damper_step_limit = 1;
+  sc->damper_step_limit = 1, sc->stiffness_limit = 1;
   sc->fs_lambda_low = 0.2, sc->fs_lambda_high = 0.75;
   sc->shepard_threshold = 0.85, sc->theta_threshold = 0.95;
   sc->has_domain = 1;

@@ -2,6 +2,7 @@
  *   "RHODCKP1" u32 version u32 sizeof(real)
  *   f64 t next_out next_probe next_checkpoint checkpoint_every
  *   i64 step reflected splits merges (version 2; version 1 has no splits, merges)
+ *   f64 stiffness (version 3)
  *   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
  *   str scene_path   i32 nsets, str[nsets]   u32 nparams, (str key, str value)[nparams]
  *   u64 n next_id   i32 nfields, per field: str name, u64 elem, elem * n bytes
@@ -11,13 +12,15 @@
 #include "rhod/checkpoint.h"
 #include "rhod/io.h"
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define CK_MAGIC "RHODCKP1"
-#define CK_VERSION 2u           /* 2: the split and merge totals; version 1 is still read */
+#define CK_VERSION 3u /* 2: the split and merge totals; 3: the stiffness; 1 and 2 are still read   \
+                       */
 #define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
 
 static uint64_t fnv1a(const unsigned char *b, size_t n) {
@@ -79,6 +82,7 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
   put_i64(&w, ck->reflected);
   put_i64(&w, ck->splits);
   put_i64(&w, ck->merges);
+  put_f64(&w, ck->stiffness);
   put_u64(&w, ck->probes_bytes);
   put_i32(&w, ck->nsnap);
   put(&w, ck->snap_t, sizeof(double) * (size_t)ck->nsnap);
@@ -96,11 +100,11 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
   put_u64(&w, p->next_id);
   int32_t nf = 0;
   for (int f = 0; f < p->nfields; f++)
-    nf += p->fields[f].persistent != 0;
+    nf += p->fields[f].persistent == 1;
   put_i32(&w, nf);
   for (int f = 0; f < p->nfields; f++) {
     const rhod_field_desc *d = &p->fields[f];
-    if (!d->persistent)
+    if (d->persistent != 1)
       continue;
     rhod_to_host(*d->ptr, p->n * d->elem);
     put_str(&w, d->name);
@@ -212,7 +216,7 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   get(r, &rsize, 4, "precision");
   if (r->bad)
     return read_fail(err, errlen, path, "truncated header");
-  if (version != CK_VERSION && version != 1)
+  if (version < 1 || version > CK_VERSION)
     return read_fail(err, errlen, path, "checkpoint version %u, this rhod reads 1 to %u", version,
                      CK_VERSION);
   if (rsize != sizeof(real))
@@ -229,6 +233,8 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
     get(r, &ck->splits, 8, "split count");
     get(r, &ck->merges, 8, "merge count");
   }
+  if (version >= 3)
+    get(r, &ck->stiffness, 8, "stiffness");
   get(r, &ck->probes_bytes, 8, "probes.csv length");
   ck->nsnap = (int32_t)get_count(r, "snapshot count");
   ck->snap_t = get_array(r, (uint64_t)ck->nsnap, sizeof(double), "snapshot times");
@@ -299,6 +305,8 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
     return read_fail(err, errlen, path, "damaged: checksum mismatch");
   if (!(ck->t >= 0) || ck->step < 0 || ck->nsnap < 0)
     return read_fail(err, errlen, path, "damaged: negative time, step or snapshot count");
+  if (!(ck->stiffness >= 0 && ck->stiffness < HUGE_VAL))
+    return read_fail(err, errlen, path, "damaged: stiffness not finite and non-negative");
   return RHOD_OK;
 }
 
@@ -332,7 +340,7 @@ int rhod_checkpoint_apply(const rhod_checkpoint *ck, rhod_particles *p, char *er
   int k = 0;
   for (int f = 0; f < p->nfields; f++) {
     const rhod_field_desc *d = &p->fields[f];
-    if (!d->persistent)
+    if (d->persistent != 1)
       continue;
     if (k >= ck->nfields || strcmp(ck->fname[k], d->name) != 0 || ck->felem[k] != d->elem) {
       snprintf(err, errlen, "checkpoint fields do not match this build's (field %d: %s)", k,
@@ -355,7 +363,7 @@ int rhod_checkpoint_apply(const rhod_checkpoint *ck, rhod_particles *p, char *er
   k = 0;
   for (int f = 0; f < p->nfields; f++) {
     const rhod_field_desc *d = &p->fields[f];
-    if (!d->persistent)
+    if (d->persistent != 1)
       continue;
     memcpy(*d->ptr, ck->fdata[k], p->n * d->elem);
     rhod_to_device(*d->ptr, p->n * d->elem);

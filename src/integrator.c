@@ -3,6 +3,7 @@
  * RK2 (Heun) y_{n+1} = y_n + dt/2 (k1 + k2), k2 at y_n + dt k1. */
 #include "rhod/integrator.h"
 #include "rhod/scene.h"
+#include <math.h>
 #include <string.h>
 
 /* Butcher weights (times their divisor) and the next stage's fraction of dt */
@@ -35,6 +36,47 @@ int rhod_rk_add(rhod_rk *rk, rhod_particles *p, real **state, real **deriv, int 
   return st;
 }
 
+int rhod_rk_watch(rhod_rk *rk, rhod_particles *p, int v, real w) {
+  if (v < 0 || v >= rk->nvars || !(w > 0 && isfinite(w)))
+    return RHOD_ERR_SCENE; /* the weights come from the scene (c0, rho0) */
+  if (rk->method != RHOD_INTEGRATOR_RK4)
+    return RHOD_OK; /* nothing to measure: no third stage */
+  if (!rk->d21[v]) {
+    /* the store keeps the name's pointer */
+    static const char *names[RHOD_RK_MAX_VARS] = {"rk_d21_0", "rk_d21_1", "rk_d21_2", "rk_d21_3",
+                                                  "rk_d21_4", "rk_d21_5", "rk_d21_6", "rk_d21_7"};
+    const int st =
+        rhod_particles_add_field(p, names[v], (void **)&rk->d21[v], sizeof(real), RHOD_FIELD_STEP);
+    if (st != RHOD_OK)
+      return st;
+  }
+  rk->watch[v] = w;
+  return RHOD_OK;
+}
+
+real rhod_rk_stiffness(const rhod_rk *rk, const rhod_particles *p, real dt, const uint8_t *skip) {
+  const long n = (long)p->n;
+  const real h = dt / 2;
+  double num = 0, den = 0;
+  for (int v = 0; v < rk->nvars; v++) {
+    if (!(rk->watch[v] > 0))
+      continue;
+    const real *d = *rk->deriv[v], *d21 = rk->d21[v], *sum = rk->sum[v];
+    const int st = rk->stride[v], of = rk->offset[v];
+    real a = 0, b = 0;
+    /* here sum = k1 + 2 k2 and d21 = k2 - k1, so k2 = (sum + d21) / 3 */
+    RHOD_KERNEL_LOOP_REDUCE2(+, a, b)
+    for (long i = 0; i < n; i++) {
+      const real dy = skip && skip[i] ? 0 : h * d21[i];
+      const real dk = d[st * i + of] - (sum[i] + d21[i]) / 3;
+      a += dy * dk, b += dy * dy;
+    }
+    const double w2 = (double)rk->watch[v] * rk->watch[v];
+    num += w2 * a, den += w2 * b;
+  }
+  return den > 0 ? (real)(num / den) : 0;
+}
+
 void rhod_rk_begin(rhod_rk *rk, const rhod_particles *p) {
   const long n = (long)p->n;
   for (int v = 0; v < rk->nvars; v++) {
@@ -59,6 +101,13 @@ void rhod_rk_stage(rhod_rk *rk, const rhod_particles *p, int s, real dt) {
     const real *d = *rk->deriv[v];
     real *y0 = rk->y0[v], *sum = rk->sum[v];
     const int st = rk->stride[v], of = rk->offset[v];
+    /* the stiffness measure keeps k2 - k1; at stage 1 the sum holds k1 */
+    if (s == 1 && !rk2 && rk->watch[v] > 0) {
+      real *d21 = rk->d21[v];
+      RHOD_KERNEL_LOOP
+      for (long i = 0; i < n; i++)
+        d21[i] = d[st * i + of] - sum[i];
+    }
     RHOD_KERNEL_LOOP
     for (long i = 0; i < n; i++) {
       const real k = d[st * i + of];

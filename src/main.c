@@ -136,6 +136,7 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
   ck.reflected = c->sim.reflected;
   ck.splits = c->sim.apr.split_total;
   ck.merges = c->sim.apr.merged_total;
+  ck.stiffness = c->sim.sph.st_lambda;
   long pos = c->csv.f ? ftell(c->csv.f) : -1;
   ck.probes_bytes = pos > 0 ? (uint64_t)pos : 0;
   ck.nsnap = c->nsnap;
@@ -201,11 +202,12 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
                         "  \"us_per_particle_step\": %.6g,\n  \"precision\": \"%s\",\n"
                         "  \"threads\": %d,\n  \"kernels_ran_on\": \"%s\",\n"
                         "  \"wall_reflections\": %ld,\n  \"splits\": %ld,\n  \"merges\": %ld,\n"
-                        "  \"damper_limited_steps\": %ld,\n  \"probes\": {",
+                        "  \"damper_limited_steps\": %ld,\n  \"stiffness_limited_steps\": %ld,\n"
+                        "  \"probes\": {",
                         status, cause, c->sc->path, s->p.n, s->step, s->t, s->dt, wall,
                         psteps > 0 ? 1e6 * wall / psteps : 0.0, RHOD_REAL_NAME,
                         omp_get_max_threads(), c->where, s->reflected, s->apr.split_total,
-                        s->apr.merged_total, s->damper_limited);
+                        s->apr.merged_total, s->damper_limited, s->stiffness_limited);
   for (unsigned k = 0; k < c->nprobe_cols && o < sizeof buf - 200; k++)
     o += (size_t)snprintf(buf + o, sizeof buf - o, "%s\n    \"%s\": %.9g", k ? "," : "",
                           c->probe_names[k], c->probe_vals ? c->probe_vals[k] : 0.0);
@@ -343,6 +345,7 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       c.sim.reflected = ck.reflected;
       c.sim.apr.split_total = ck.splits;
       c.sim.apr.merged_total = ck.merges;
+      c.sim.sph.st_lambda = (real)ck.stiffness;
       c.sim.dt = rhod_sph_dt(&c.sim.sph, &c.sim.p); /* sizes may have been split since t = 0 */
       st = rhod_sim_prepare(&c.sim, 1);
       if (st != RHOD_OK)
@@ -513,6 +516,10 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       logline("rhod: %ld of the %ld steps run here took a dt set by the acoustic damper's "
               "measured stiffness (scheme.damper_step_limit)",
               s->damper_limited, s->step - c.step0);
+    if (s->stiffness_limited)
+      logline("rhod: %ld of the %ld steps run here took a dt set by the stiffness the RK4 "
+              "stages measured (time.stiffness_limit)",
+              s->stiffness_limited, s->step - c.step0);
     st = write_summary(&c, "ok", "", wall);
   }
   goto cleanup;

@@ -17,7 +17,7 @@ static int alloc_field(rhod_field_desc *f, size_t cap) {
 static size_t scratch_elem(const rhod_particles *p) {
   size_t m = sizeof(double);
   for (int i = 0; i < p->nfields; i++)
-    if (p->fields[i].persistent && p->fields[i].elem > m)
+    if (p->fields[i].persistent == 1 && p->fields[i].elem > m)
       m = p->fields[i].elem;
   return m;
 }
@@ -46,7 +46,7 @@ int rhod_particles_add_field(rhod_particles *p, const char *name, void **ptr, si
   if (st != RHOD_OK)
     return st;
   p->nfields++;
-  if (persistent && p->scratch && elem > p->scratch_elem) {
+  if (persistent == 1 && p->scratch && elem > p->scratch_elem) {
     free_scratch(p);
     st = alloc_scratch(p);
   }
@@ -169,7 +169,7 @@ static void permute_bytes(void *arr, void *scratch, const int32_t *perm, size_t 
 void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count) {
   for (int i = 0; i < p->nfields; i++) {
     rhod_field_desc *f = &p->fields[i];
-    if (f->persistent)
+    if (f->persistent == 1)
       gather_bytes(*f->ptr, p->n, *f->ptr, src, count, f->elem);
   }
   p->n += count;
@@ -179,19 +179,19 @@ void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count) 
 void rhod_particles_permute(rhod_particles *p) {
   for (int i = 0; i < p->nfields; i++) {
     rhod_field_desc *f = &p->fields[i];
-    if (f->persistent)
+    if (f->persistent == 1)
       permute_bytes(*f->ptr, p->scratch, p->perm, p->n, f->elem);
   }
 }
 
 void rhod_particles_to_device(rhod_particles *p) {
   for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent)
+    if (p->fields[f].persistent == 1)
       rhod_to_device(*p->fields[f].ptr, p->n * p->fields[f].elem);
 }
 
 void rhod_particles_to_host(rhod_particles *p) {
   for (int f = 0; f < p->nfields; f++)
-    if (p->fields[f].persistent)
+    if (p->fields[f].persistent == 1)
       rhod_to_host(*p->fields[f].ptr, p->n * p->fields[f].elem);
 }

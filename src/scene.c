@@ -77,6 +77,7 @@ typedef struct {
   double end, output_every;
   double *cfl, *cfl_visc;
   int *integrator;
+  bool *stiffness_limit;
 } y_time;
 
 typedef struct {
@@ -263,6 +264,7 @@ static const cyaml_schema_field_t f_time[] = {
     NUM_OPT("cfl", y_time, cfl),
     NUM_OPT("cfl_visc", y_time, cfl_visc),
     ENUM_OPT("integrator", y_time, integrator, integrator_names),
+    BOOL_OPT("stiffness_limit", y_time, stiffness_limit),
     CYAML_FIELD_END,
 };
 
@@ -1360,6 +1362,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->cfl_visc = opt(d->time.cfl_visc, 0.025);
   s->integrator =
       d->time.integrator ? (rhod_integrator_kind)*d->time.integrator : RHOD_INTEGRATOR_RK4;
+  s->stiffness_limit = opt_bool(d->time.stiffness_limit, 1);
   TRY(check_positive(c, "time.end", s->t_end));
   TRY(check_positive(c, "time.output_every", s->output_every));
   TRY(check_range(c, "time.cfl", s->cfl, 0, 1, 1, 0));
@@ -1743,6 +1746,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "cfl_visc", s->cfl_visc);
   tb_word(&t, m, "integrator",
           strval_name(integrator_names, CYAML_ARRAY_LEN(integrator_names), (int)s->integrator));
+  if (!s->stiffness_limit) /* present only when off, so checkpoints made before the key resume */
+    tb_bool(&t, m, "stiffness_limit", s->stiffness_limit);
   m = tb_coll(&t, root, "particles", RY_MAP, 0);
   tb_num(&t, m, "dx", s->dx);
   tb_num(&t, m, "radius_ratio", s->radius_ratio);

@@ -358,6 +358,15 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     st = rhod_rk_add(&s->rk, p, &p->uy, &h->acc, 2, 1);
   if (st == RHOD_OK)
     st = rhod_rk_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
+  /* the stiffness limit measures u and rho in the acoustic energy's scales, u / c0 and
+   * rho / rho0 (positions left out: dx/dt = u makes their stage differences those of u,
+   * a ratio near dt c0 / dx whatever the stiffness); the variables in rhod_rk_add's order */
+  if (st == RHOD_OK && h->stlim)
+    st = rhod_rk_watch(&s->rk, p, 2, 1 / h->c0);
+  if (st == RHOD_OK && h->stlim)
+    st = rhod_rk_watch(&s->rk, p, 3, 1 / h->c0);
+  if (st == RHOD_OK && h->stlim)
+    st = rhod_rk_watch(&s->rk, p, 4, 1 / h->rho0);
   if (st != RHOD_OK) {
     snprintf(err, errlen, "out of memory setting up the scheme");
     return st;
@@ -536,8 +545,10 @@ int rhod_sim_dt(rhod_sim *s) {
     s->sph.ad_lambda = rhod_sph_damper_probe(&s->sph, &s->p, &s->cells);
   }
   s->dt = rhod_sph_dt(&s->sph, &s->p);
-  if (s->sph.adlim && s->sph.ad_lambda > 0 && s->dt == (real)RHOD_AD_TARGET / s->sph.ad_lambda)
+  if (s->sph.adlim && s->sph.ad_lambda > 0 && s->dt == (real)RHOD_DT_TARGET / s->sph.ad_lambda)
     s->damper_limited++;
+  else if (s->sph.stlim && s->sph.st_lambda > 0 && s->dt == (real)RHOD_DT_TARGET / s->sph.st_lambda)
+    s->stiffness_limited++;
   return RHOD_OK;
 }
 
@@ -557,6 +568,14 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
         goto mem;
     }
     rhod_sph_rhs(&s->sph, p, &s->cells, (real)dt);
+    /* the stiffness limit (docs/choices.md): the RK4 stages' stiffness over the inner
+     * particles, where the right-hand side is smooth (the free-surface region switches
+     * operators and sets between stages, which the stage differences would read as a
+     * stiffness of order 1/dt) */
+    if (stage == 2 && s->sph.stlim) {
+      const real q = rhod_rk_stiffness(&s->rk, p, (real)dt, s->sph.reg);
+      s->sph.st_lambda = q < 0 ? -q : 0;
+    }
     /* refinement criteria during the last stage (paper 002 Sec. V) */
     if (s->apr.active && stage == s->rk.stages - 1) {
       /* coalescing is looked for every RHOD_COALESCE_EVERY steps: its candidate

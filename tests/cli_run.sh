@@ -64,6 +64,22 @@ for s in snaps:
                 sys.exit(f"{s}: {k} not finite")
 PY
 
+# the stiffness limit (time.stiffness_limit, docs/choices.md): the inviscid Taylor-Green
+# box at cfl 0.7, where the damper alone stays inside RK4's bound (its step limit does
+# not bind) but the whole right-hand side does not; without the limit it stops near
+# step 47
+TG=(--set particles.dx=0.05 --set physics.mu=0 --set time.cfl=0.7 --set time.end=2
+  --set time.output_every=1)
+expect 0 "the stiffness limit keeps a stiff mode at bay" -- \
+  "$RHOD" run "$SRC/cases/taylor_green/scene.yaml" -o "$T/stiff" "${TG[@]}"
+check "the log counts the steps it set" -- grep -q "set by the stiffness the RK4 stages" \
+  "$T/stiff/run.log"
+check "summary counts them too" -- bash -c "grep -q '\"stiffness_limited_steps\": [1-9]' \
+  '$T/stiff/summary.json'"
+expect 6 "without it the same run stops" -- "$RHOD" run "$SRC/cases/taylor_green/scene.yaml" \
+  -o "$T/nostiff" "${TG[@]}" --set time.stiffness_limit=false
+check "no damper step in either" -- bash -c "! grep -q 'damper.s measured' '$T/stiff/run.log'"
+
 # the torque_budget probe reads the state without changing the run: its scene without
 # the probe gives the same other columns, bit for bit
 TQ=$SRC/tests/scenes/run/rotating_torque.yaml

@@ -710,7 +710,7 @@ static double damper_dense_lambda(const rhod_particles *p, const rhod_sph *s) {
  * RESULTS.md): placed freely, or one file 0.7 dx from a free-slip or a no-slip wall
  * (its mirror the other); and a lattice. Repeated probes converge to the reference,
  * past RK4's bound at Eq. 11's dt in the films, and rhod_sph_dt then holds dt |lambda|
- * at RHOD_AD_TARGET; on the lattice the limit does not bind. */
+ * at RHOD_DT_TARGET; on the lattice the limit does not bind. */
 static void test_damper_probe(void) {
   const double dx = 0.01, dt11 = 0.5 * 4 * dx / 20; /* Eq. 11: cfl 0.5, R = 4 dx, c0 = 20 */
   const char *name[4] = {"free film", "film on a free-slip wall", "film on a no-slip wall",
@@ -768,11 +768,11 @@ static void test_damper_probe(void) {
        * the probe equals the reference to 4 digits in all four cases, checked once) */
       CU_ASSERT_DOUBLE_EQUAL(lam, ref, TOL(5e-3, 1e-2) * ref);
       CU_ASSERT(dt11 * ref > 2.785);                          /* past RK4's bound at Eq. 11 */
-      CU_ASSERT_DOUBLE_EQUAL(dt * ref, RHOD_AD_TARGET, 1e-2); /* held at the target */
+      CU_ASSERT_DOUBLE_EQUAL(dt * ref, RHOD_DT_TARGET, 1e-2); /* held at the target */
     } else {
       /* on a finite lattice the top modes are close: the estimate may still be low */
       CU_ASSERT(lam > 0.9 * ref && lam <= 1.0001 * ref);
-      CU_ASSERT(dt11 * ref < RHOD_AD_TARGET);
+      CU_ASSERT(dt11 * ref < RHOD_DT_TARGET);
       CU_ASSERT_DOUBLE_EQUAL(dt, dt11, TOL(1e-9, 1e-6) * dt11); /* not binding */
     }
     if (wall)
@@ -1014,6 +1014,74 @@ static void test_rk_order(void) {
   CU_ASSERT(e2b < 1e-2);
 }
 
+/* The RK4 stages' stiffness (rhod_rk_stiffness) on x' = lambda_i x, y' = mu_i y, particle
+ * by particle: dK = k3 - k2 = lambda dY for each component, so q is the mean of the rates
+ * weighted by w_v^2 dY^2, dY = (dt/2)^2 lambda^2 y0: the stiffest mode dominates. */
+static double rk_stiffness_case(rhod_integrator_kind method, int watch_y, int skip_last,
+                                double *expect) {
+  const int n = 3;
+  const double lam[3] = {-1000, -3, -5000}, mu[3] = {-200, -40, -7}, w[2] = {1, 2}, dt = 1e-3;
+  rhod_particles p;
+  rhod_particles_init(&p, 8);
+  p.n = (size_t)n;
+  real *d = NULL;
+  uint8_t *skip = NULL;
+  rhod_particles_add_field(&p, "d", (void **)&d, 2 * sizeof(real), 0);
+  rhod_particles_add_field(&p, "skip", (void **)&skip, 1, 0);
+  rhod_rk rk;
+  rhod_rk_init(&rk, &p, method);
+  rhod_rk_add(&rk, &p, &p.x, &d, 2, 0);
+  rhod_rk_add(&rk, &p, &p.y, &d, 2, 1);
+  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 0, (real)w[0]), RHOD_OK);
+  if (watch_y)
+    CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 1, (real)w[1]), RHOD_OK);
+  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 2, 1), RHOD_ERR_SCENE); /* no such variable */
+  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 0, 0), RHOD_ERR_SCENE); /* a weight of 0 */
+  double num = 0, den = 0;
+  for (int i = 0; i < n; i++) {
+    p.x[i] = (real)(1 + i), p.y[i] = (real)(2 - i);
+    skip[i] = skip_last && i == n - 1;
+    for (int v = 0; v < 1 + watch_y; v++) { /* the stages by hand */
+      const double r = v ? mu[i] : lam[i], y0 = v ? p.y[i] : p.x[i];
+      const double k1 = r * y0, k2 = r * (y0 + dt / 2 * k1), dY = dt / 2 * (k2 - k1);
+      if (!skip[i])
+        num += w[v] * w[v] * r * dY * dY, den += w[v] * w[v] * dY * dY;
+    }
+  }
+  *expect = num / den;
+  rhod_particles_to_device(&p);
+  rhod_to_device(skip, (size_t)n);
+  real q = 0;
+  rhod_rk_begin(&rk, &p);
+  for (int st = 0; st < rk.stages; st++) {
+    rhod_to_host(p.x, (size_t)n * sizeof(real));
+    rhod_to_host(p.y, (size_t)n * sizeof(real));
+    for (int i = 0; i < n; i++)
+      d[2 * i] = (real)lam[i] * p.x[i], d[2 * i + 1] = (real)mu[i] * p.y[i];
+    rhod_to_device(d, 2 * (size_t)n * sizeof(real));
+    if (st == 2)
+      q = rhod_rk_stiffness(&rk, &p, (real)dt, skip);
+    rhod_rk_stage(&rk, &p, st, (real)dt);
+  }
+  rhod_particles_free(&p);
+  return q;
+}
+
+static void test_rk_stiffness(void) {
+  double e = 0;
+  const double q1 = rk_stiffness_case(RHOD_INTEGRATOR_RK4, 0, 1, &e);
+  printf("\n  one watched variable, two particles: q %.6g, expected %.6g", q1, e);
+  CU_ASSERT_DOUBLE_EQUAL(q1, e, TOL(1e-9, 1e-4) * fabs(e));
+  const double q2 = rk_stiffness_case(RHOD_INTEGRATOR_RK4, 1, 1, &e);
+  printf("\n  two weighted variables: q %.6g, expected %.6g", q2, e);
+  CU_ASSERT_DOUBLE_EQUAL(q2, e, TOL(1e-9, 1e-4) * fabs(e));
+  const double q3 = rk_stiffness_case(RHOD_INTEGRATOR_RK4, 1, 0, &e);
+  CU_ASSERT_DOUBLE_EQUAL(q3, e, TOL(1e-9, 1e-4) * fabs(e)); /* nothing skipped */
+  CU_ASSERT(q3 < -4900 && q2 > -1001);   /* the skipped particle holds the stiffest mode */
+  CU_ASSERT(q1 > -1000.01 && q1 < -990); /* dY ~ lambda^2: the stiff mode dominates */
+  CU_ASSERT_EQUAL(rk_stiffness_case(RHOD_INTEGRATOR_RK2, 1, 0, &e), 0); /* nothing watched */
+}
+
 int main(void) {
   omp_set_num_threads(2);
   const rhod_test_case cases[] = {
@@ -1034,6 +1102,7 @@ int main(void) {
       {"torque budget: adds up, zero for the conservative forms", test_torque_budget},
       {"PVRS and limiter hand values", test_pvrs_hand_values},
       {"RK4 fourth order, RK2 second order", test_rk_order},
+      {"RK4 stages' stiffness: the rate of a linear system", test_rk_stiffness},
       {"wall-crossing guard, corners included", test_walls_guard},
       {"damper step limit: the probe finds Eq. 9's largest eigenvalue", test_damper_probe},
   };

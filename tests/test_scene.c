@@ -40,6 +40,7 @@ static void test_full_scene(void) {
   CLOSE(s->output_every, 0.05);
   CLOSE(s->cfl, 0.4);
   CLOSE(s->cfl_visc, 0.02);
+  CU_ASSERT_FALSE(s->stiffness_limit);
   CLOSE(s->dx, 0.01);
   CLOSE(s->radius_ratio, 3);
   CU_ASSERT_EQUAL(s->kernel, RHOD_KERNEL_QUINTIC);
@@ -145,6 +146,7 @@ static void test_defaults(void) {
   CU_ASSERT_TRUE(s->acoustic_damper);
   CLOSE(s->alpha_ad, 1);
   CU_ASSERT_TRUE(s->damper_step_limit);
+  CU_ASSERT_TRUE(s->stiffness_limit);
   CU_ASSERT_FALSE(s->tensile_control);
   CU_ASSERT_FALSE(s->shifting_switch);
   CU_ASSERT_TRUE(s->free_surface);

@@ -15,7 +15,7 @@ static inline rhod_scene *unit_scene(double dx) {
   sc->rho0 = 1000, sc->c0 = 20, sc->mu = 0;
   sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = sc->free_surface = 1;
   sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
-  sc->damper_step_limit = 1;
+  sc->damper_step_limit = 1, sc->stiffness_limit = 1;
   sc->fs_lambda_low = 0.2, sc->fs_lambda_high = 0.75;
   sc->shepard_threshold = 0.85, sc->theta_threshold = 0.95;
   sc->path = "unit";

@@ -20,6 +20,7 @@ typedef struct {
   double t, next_out, next_probe, next_checkpoint, checkpoint_every;
   int64_t step, reflected;
   int64_t splits, merges; /* APR totals of the run so far (0 from a version-1 file) */
+  double stiffness;       /* the stiffness limit's last measure, 1/s (0 before version 3) */
   uint64_t probes_bytes;  /* length of probes.csv when the checkpoint was taken */
   int32_t nsnap;
   double *snap_t;

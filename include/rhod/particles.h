@@ -13,12 +13,17 @@
 #include <stdint.h>
 
 #define RHOD_MAX_FIELDS 96
+/* A field's `persistent` for a value that lives within one step: kept when the store grows
+ * in the middle of a step (new ghosts), but not reordered, appended, copied to or from the
+ * device as state, or checkpointed, since it holds nothing from one step to the next. */
+#define RHOD_FIELD_STEP 2
 
 typedef struct {
   const char *name;
   void **ptr;     /* address of the owner's pointer variable */
   size_t elem;    /* bytes per particle */
-  int persistent; /* 1: carried across steps and reordered with the particles */
+  int persistent; /* 1: carried across steps and reordered with the particles;
+                     RHOD_FIELD_STEP: see there; 0: scratch */
 } rhod_field_desc;
 
 typedef struct {

@@ -149,6 +149,8 @@ typedef struct {
   double cfl;                      /* time.cfl, CFL_h of Eq. 11, default 0.5 */
   double cfl_visc;                 /* time.cfl_visc, CFL_mu of Eq. 11, default 0.025 */
   rhod_integrator_kind integrator; /* time.integrator, default rk4 */
+  int stiffness_limit;             /* time.stiffness_limit: dt also kept below the stiffness
+                                      the RK4 stages measure (integrator.h); default on */
   /* particles: */
   double dx;               /* particles.dx [m] (required) */
   double radius_ratio;     /* particles.radius_ratio = R/dx, default 4 (paper 002 Sec. IV D) */

@@ -29,10 +29,11 @@ typedef struct {
   double mirror_ratio; /* wall mirrors within mirror_ratio * dx_i of a wall */
   double t, dt;
   long step;
-  double particle_steps; /* sum over the steps run by this process of the particle count */
-  long reflected;        /* particles put back by the wall-crossing guard, whole run */
-  long damper_limited;   /* steps of this process whose dt the damper step limit set */
-  int neighbours_fresh;  /* ghosts and cells match the current state */
+  double particle_steps;  /* sum over the steps run by this process of the particle count */
+  long reflected;         /* particles put back by the wall-crossing guard, whole run */
+  long damper_limited;    /* steps of this process whose dt the damper step limit set */
+  long stiffness_limited; /* ... and those whose dt the stiffness limit set */
+  int neighbours_fresh;   /* ghosts and cells match the current state */
 } rhod_sim;
 
 /* Fills the fluid from the scene (square lattice of spacing dx, initial pressure) and

@@ -24,6 +24,9 @@ typedef struct {
   real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
   real ad_lambda; /* largest |eigenvalue| of Eq. 9 as last measured (rhod_sph_damper_probe);
                      0: none */
+  int stlim;      /* time.stiffness_limit (and RK4) */
+  real st_lambda; /* stiffness of the last step's RK4 stages, -q of rhod_rk_stiffness over
+                     the inner particles (1/s); 0: none */
   /* per-particle fields (scratch, rebuilt each stage) */
   real *P, *V;
   real *gam, *ggam;       /* Shepard Gamma (Eq. 7) and its gradient (Eq. 27), 2 */
@@ -72,9 +75,10 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
  * along the shifting direction J of Eqs. 25-26; cells and ghosts must be current. */
 void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c);
 
-/* Target of the damper step limit: dt |lambda| of Eq. 9 kept at or below this, RK4
- * being stable down to dt lambda = -2.785 on the real axis (rhod_sph.c). */
-#define RHOD_AD_TARGET 2.2
+/* Target of the measured step limits: dt |lambda| of Eq. 9 (the damper step limit) and
+ * dt times the stiffness of the RK4 stages (the stiffness limit) kept at or below this,
+ * RK4 being stable down to dt lambda = -2.785 on the real axis (rhod_sph.c). */
+#define RHOD_DT_TARGET 2.2
 /* The initial relaxation's step (rhod_sph_relax): coefficient of delta x = beta dx J and
  * the largest step, both in units of the particle's size. */
 #define RHOD_RELAX_BETA 0.25
@@ -110,8 +114,8 @@ enum {
 void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt, real ax,
                             real ay, double out[RHOD_TQ_TERMS]);
 
-/* Time step of Eq. 11 over the fluid, and with adlim no more than RHOD_AD_TARGET /
- * ad_lambda. */
+/* Time step of Eq. 11 over the fluid, with adlim no more than RHOD_DT_TARGET / ad_lambda,
+ * and with stlim no more than RHOD_DT_TARGET / st_lambda. */
 real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p);
 
 #endif
