@@ -1078,7 +1078,7 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
   return n0 > 0 ? sqrt(nw / n0) : 0;
 }
 
-real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {
+real rhod_sph_dt(rhod_sph *s, const rhod_particles *p) {
   const long n = (long)p->n;
   const real *dx = p->dx;
   real dmin = (real)FLT_MAX;
@@ -1096,15 +1096,21 @@ real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p) {
     const real d3 = s->cfl_visc * s->rho0 * R * R / s->mu;
     dt = d3 < dt ? d3 : dt;
   }
+  s->dt_by = RHOD_DT_BY_EQ11;
   /* the damper step limit (rhod_sph_damper_probe) */
   if (s->adlim && s->ad_lambda > 0) {
     const real d4 = (real)RHOD_DT_TARGET / s->ad_lambda;
-    dt = d4 < dt ? d4 : dt;
+    if (d4 < dt)
+      dt = d4, s->dt_by = RHOD_DT_BY_DAMPER;
   }
-  /* the stiffness limit (rhod_sim_step, rhod_rk_stiffness) */
+  /* the stiffness limit (rhod_sim_step, rhod_rk_stiffness), never below RHOD_ST_FLOOR of
+   * the others: a stiffness that does not scale with dt (a switch between stages that
+   * the inner particles' mask misses) must not drive dt down step after step */
   if (s->stlim && s->st_lambda > 0) {
-    const real d5 = (real)RHOD_DT_TARGET / s->st_lambda;
-    dt = d5 < dt ? d5 : dt;
+    real d5 = (real)RHOD_DT_TARGET / s->st_lambda;
+    d5 = d5 > (real)RHOD_ST_FLOOR * dt ? d5 : (real)RHOD_ST_FLOOR * dt;
+    if (d5 < dt)
+      dt = d5, s->dt_by = RHOD_DT_BY_STIFFNESS;
   }
   return dt;
 }

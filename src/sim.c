@@ -545,10 +545,8 @@ int rhod_sim_dt(rhod_sim *s) {
     s->sph.ad_lambda = rhod_sph_damper_probe(&s->sph, &s->p, &s->cells);
   }
   s->dt = rhod_sph_dt(&s->sph, &s->p);
-  if (s->sph.adlim && s->sph.ad_lambda > 0 && s->dt == (real)RHOD_DT_TARGET / s->sph.ad_lambda)
-    s->damper_limited++;
-  else if (s->sph.stlim && s->sph.st_lambda > 0 && s->dt == (real)RHOD_DT_TARGET / s->sph.st_lambda)
-    s->stiffness_limited++;
+  s->damper_limited += s->sph.dt_by == RHOD_DT_BY_DAMPER;
+  s->stiffness_limited += s->sph.dt_by == RHOD_DT_BY_STIFFNESS;
   return RHOD_OK;
 }
 

@@ -710,7 +710,8 @@ static double damper_dense_lambda(const rhod_particles *p, const rhod_sph *s) {
  * RESULTS.md): placed freely, or one file 0.7 dx from a free-slip or a no-slip wall
  * (its mirror the other); and a lattice. Repeated probes converge to the reference,
  * past RK4's bound at Eq. 11's dt in the films, and rhod_sph_dt then holds dt |lambda|
- * at RHOD_DT_TARGET; on the lattice the limit does not bind. */
+ * at RHOD_DT_TARGET; on the lattice the limit does not bind, and the stiffness limit
+ * (time.stiffness_limit) on top of it binds down to its floor. */
 static void test_damper_probe(void) {
   const double dx = 0.01, dt11 = 0.5 * 4 * dx / 20; /* Eq. 11: cfl 0.5, R = 4 dx, c0 = 20 */
   const char *name[4] = {"free film", "film on a free-slip wall", "film on a no-slip wall",
@@ -769,11 +770,22 @@ static void test_damper_probe(void) {
       CU_ASSERT_DOUBLE_EQUAL(lam, ref, TOL(5e-3, 1e-2) * ref);
       CU_ASSERT(dt11 * ref > 2.785);                          /* past RK4's bound at Eq. 11 */
       CU_ASSERT_DOUBLE_EQUAL(dt * ref, RHOD_DT_TARGET, 1e-2); /* held at the target */
+      CU_ASSERT_EQUAL(cl.s.dt_by, RHOD_DT_BY_DAMPER);
     } else {
       /* on a finite lattice the top modes are close: the estimate may still be low */
       CU_ASSERT(lam > 0.9 * ref && lam <= 1.0001 * ref);
       CU_ASSERT(dt11 * ref < RHOD_DT_TARGET);
       CU_ASSERT_DOUBLE_EQUAL(dt, dt11, TOL(1e-9, 1e-6) * dt11); /* not binding */
+      CU_ASSERT_EQUAL(cl.s.dt_by, RHOD_DT_BY_EQ11);
+      /* the stiffness limit on top: dt |q| held at the target, but never below
+       * RHOD_ST_FLOOR of the other limits */
+      cl.s.stlim = 1, cl.s.st_lambda = (real)(RHOD_DT_TARGET / (0.5 * dt11));
+      CU_ASSERT_DOUBLE_EQUAL(rhod_sph_dt(&cl.s, p), 0.5 * dt11, TOL(1e-9, 1e-6) * dt11);
+      CU_ASSERT_EQUAL(cl.s.dt_by, RHOD_DT_BY_STIFFNESS);
+      cl.s.st_lambda = (real)1e12;
+      CU_ASSERT_DOUBLE_EQUAL(rhod_sph_dt(&cl.s, p), RHOD_ST_FLOOR * dt11, TOL(1e-9, 1e-6) * dt11);
+      cl.s.stlim = 0;
+      CU_ASSERT_DOUBLE_EQUAL(rhod_sph_dt(&cl.s, p), dt11, TOL(1e-9, 1e-6) * dt11);
     }
     if (wall)
       rhod_boundary_free(&b);

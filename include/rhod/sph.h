@@ -8,6 +8,9 @@
 #include "rhod/particles.h"
 #include "rhod/scene.h"
 
+/* rhod_sph_dt's binding limit */
+enum { RHOD_DT_BY_EQ11, RHOD_DT_BY_DAMPER, RHOD_DT_BY_STIFFNESS };
+
 typedef struct {
   /* parameters (from the scene) */
   int kernel;
@@ -25,6 +28,7 @@ typedef struct {
   real ad_lambda; /* largest |eigenvalue| of Eq. 9 as last measured (rhod_sph_damper_probe);
                      0: none */
   int stlim;      /* time.stiffness_limit (and RK4) */
+  int dt_by;      /* which limit set the last rhod_sph_dt: RHOD_DT_BY_* */
   real st_lambda; /* stiffness of the last step's RK4 stages, -q of rhod_rk_stiffness over
                      the inner particles (1/s); 0: none */
   /* per-particle fields (scratch, rebuilt each stage) */
@@ -79,6 +83,8 @@ void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c);
  * dt times the stiffness of the RK4 stages (the stiffness limit) kept at or below this,
  * RK4 being stable down to dt lambda = -2.785 on the real axis (rhod_sph.c). */
 #define RHOD_DT_TARGET 2.2
+/* The stiffness limit takes dt down to this fraction of the other limits' at most. */
+#define RHOD_ST_FLOOR 0.1
 /* The initial relaxation's step (rhod_sph_relax): coefficient of delta x = beta dx J and
  * the largest step, both in units of the particle's size. */
 #define RHOD_RELAX_BETA 0.25
@@ -115,7 +121,8 @@ void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real 
                             real ay, double out[RHOD_TQ_TERMS]);
 
 /* Time step of Eq. 11 over the fluid, with adlim no more than RHOD_DT_TARGET / ad_lambda,
- * and with stlim no more than RHOD_DT_TARGET / st_lambda. */
-real rhod_sph_dt(const rhod_sph *s, const rhod_particles *p);
+ * and with stlim no more than RHOD_DT_TARGET / st_lambda but at least RHOD_ST_FLOOR of the
+ * rest; dt_by says which one set it. */
+real rhod_sph_dt(rhod_sph *s, const rhod_particles *p);
 
 #endif
