@@ -19,9 +19,8 @@
 #include <string.h>
 
 #define CK_MAGIC "RHODCKP1"
-#define CK_VERSION                                                                                 \
-  3u /* 2: the split and merge totals; 3: the stiffness; 1 and 2 are still read                    \
-      */
+/* 2: the split and merge totals; 3: the stiffness limit's measure; 1 and 2 are still read */
+#define CK_VERSION 3u
 #define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
 
 static uint64_t fnv1a(const unsigned char *b, size_t n) {

@@ -23,7 +23,7 @@ typedef struct {
   int stride[RHOD_RK_MAX_VARS], offset[RHOD_RK_MAX_VARS];
   real *y0[RHOD_RK_MAX_VARS], *sum[RHOD_RK_MAX_VARS]; /* registered persistent fields */
   /* the stiffness measure (rhod_rk_stiffness): a variable's weight, 0 where it is not
-   * measured, and its k2 - k1 (a registered persistent field, RK4 only) */
+   * measured, and its k2 - k1 (a registered RHOD_FIELD_STEP field, RK4 only) */
   real watch[RHOD_RK_MAX_VARS];
   real *d21[RHOD_RK_MAX_VARS];
 } rhod_rk;
