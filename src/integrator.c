@@ -36,8 +36,11 @@ int rhod_rk_add(rhod_rk *rk, rhod_particles *p, real **state, real **deriv, int 
   return st;
 }
 
-int rhod_rk_watch(rhod_rk *rk, rhod_particles *p, int v, real w) {
-  if (v < 0 || v >= rk->nvars || !(w > 0 && isfinite(w)))
+int rhod_rk_watch(rhod_rk *rk, rhod_particles *p, real **state, real w) {
+  int v = 0;
+  while (v < rk->nvars && rk->state[v] != state)
+    v++;
+  if (v == rk->nvars || !(w > 0 && isfinite(w)))
     return RHOD_ERR_SCENE; /* the weights come from the scene (c0, rho0) */
   if (rk->method != RHOD_INTEGRATOR_RK4)
     return RHOD_OK; /* nothing to measure: no third stage */
@@ -102,15 +105,12 @@ void rhod_rk_stage(rhod_rk *rk, const rhod_particles *p, int s, real dt) {
     real *y0 = rk->y0[v], *sum = rk->sum[v];
     const int st = rk->stride[v], of = rk->offset[v];
     /* the stiffness measure keeps k2 - k1; at stage 1 the sum holds k1 */
-    if (s == 1 && !rk2 && rk->watch[v] > 0) {
-      real *d21 = rk->d21[v];
-      RHOD_KERNEL_LOOP
-      for (long i = 0; i < n; i++)
-        d21[i] = d[st * i + of] - sum[i];
-    }
+    real *d21 = s == 1 && !rk2 && rk->watch[v] > 0 ? rk->d21[v] : NULL;
     RHOD_KERNEL_LOOP
     for (long i = 0; i < n; i++) {
       const real k = d[st * i + of];
+      if (d21)
+        d21[i] = k - sum[i];
       const real acc = sum[i] + ws * k;
       sum[i] = acc;
       y[i] = last ? y0[i] + d6 * acc : y0[i] + cs * k;

@@ -360,13 +360,13 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     st = rhod_rk_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
   /* the stiffness limit measures u and rho in the acoustic energy's scales, u / c0 and
    * rho / rho0 (positions left out: dx/dt = u makes their stage differences those of u,
-   * a ratio near dt c0 / dx whatever the stiffness); the variables in rhod_rk_add's order */
+   * a ratio near dt c0 / dx whatever the stiffness) */
   if (st == RHOD_OK && h->stlim)
-    st = rhod_rk_watch(&s->rk, p, 2, 1 / h->c0);
+    st = rhod_rk_watch(&s->rk, p, &p->ux, 1 / h->c0);
   if (st == RHOD_OK && h->stlim)
-    st = rhod_rk_watch(&s->rk, p, 3, 1 / h->c0);
+    st = rhod_rk_watch(&s->rk, p, &p->uy, 1 / h->c0);
   if (st == RHOD_OK && h->stlim)
-    st = rhod_rk_watch(&s->rk, p, 4, 1 / h->rho0);
+    st = rhod_rk_watch(&s->rk, p, &p->rho, 1 / h->rho0);
   if (st != RHOD_OK) {
     snprintf(err, errlen, "out of memory setting up the scheme");
     return st;

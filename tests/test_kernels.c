@@ -1044,11 +1044,11 @@ static double rk_stiffness_case(rhod_integrator_kind method, int watch_y, int sk
   rhod_rk_init(&rk, &p, method);
   rhod_rk_add(&rk, &p, &p.x, &d, 2, 0);
   rhod_rk_add(&rk, &p, &p.y, &d, 2, 1);
-  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 0, (real)w[0]), RHOD_OK);
+  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, &p.x, (real)w[0]), RHOD_OK);
   if (watch_y)
-    CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 1, (real)w[1]), RHOD_OK);
-  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 2, 1), RHOD_ERR_SCENE); /* no such variable */
-  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, 0, 0), RHOD_ERR_SCENE); /* a weight of 0 */
+    CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, &p.y, (real)w[1]), RHOD_OK);
+  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, &p.ux, 1), RHOD_ERR_SCENE); /* no such variable */
+  CU_ASSERT_EQUAL(rhod_rk_watch(&rk, &p, &p.x, 0), RHOD_ERR_SCENE);  /* a weight of 0 */
   double num = 0, den = 0;
   for (int i = 0; i < n; i++) {
     p.x[i] = (real)(1 + i), p.y[i] = (real)(2 - i);

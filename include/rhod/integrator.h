@@ -45,14 +45,14 @@ void rhod_rk_stage(rhod_rk *rk, const rhod_particles *p, int s, real dt);
  * is exactly lambda for y' = lambda y, and estimates the real part of the excited modes
  * (an oscillating mode adds nothing to it); q dt below -2.785 is RK4 past its bound on
  * the real axis.
- * rhod_rk_watch puts variable v (its index in the order of rhod_rk_add) into the
- * measure with weight w (the scale that makes the variables comparable); RHOD_ERR_SCENE
- * for an unknown v or a w that is not finite and positive, RHOD_ERR_MEMORY, and nothing
+ * rhod_rk_watch puts the variable of `state` (as given to rhod_rk_add) into the measure
+ * with weight w (the scale that makes the variables comparable); RHOD_ERR_SCENE for a
+ * state not added or a w that is not finite and positive, RHOD_ERR_MEMORY, and nothing
  * done with RK2 (no third stage).
  * rhod_rk_stiffness returns q (1/s): call it after the derivative of stage 2 is known and
  * before rhod_rk_stage(rk, p, 2, dt). Particles i with skip[i] != 0 are left out (skip may
  * be NULL); 0 where nothing is watched or dY vanishes. */
-int rhod_rk_watch(rhod_rk *rk, rhod_particles *p, int v, real w);
+int rhod_rk_watch(rhod_rk *rk, rhod_particles *p, real **state, real w);
 real rhod_rk_stiffness(const rhod_rk *rk, const rhod_particles *p, real dt, const uint8_t *skip);
 
 #endif
