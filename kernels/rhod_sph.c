@@ -235,10 +235,10 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   const real iWdx = 1 / rhod_Wq(kern, dxi * iR); /* R^-2/W(dx_ij) of Eq. 29, dx_j = dx_i */
   real ggx = 0, ggy = 0, B0 = 0, B1 = 0, B2 = 0, B3 = 0;
   real GPx = 0, GPy = 0, Gu0 = 0, Gu1 = 0, Gu2 = 0, Gu3 = 0, div = 0, cx = 0, cy = 0, um = 0;
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
     RHOD_SIMD(reduction(+ : g, ggx, ggy, B0, B1, B2, B3, GPx, GPy, Gu0, Gu1, Gu2, Gu3, div, cx,
                         cy) reduction(max : um))
-    for (int k = k0; k < k1; k++) {
+    for (int k = k0; k < kv; k++) {
       PAIR_OR_SKIP(k);
       const real Vj = kV[k];
       const real q = r * iR;
@@ -294,9 +294,9 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
      * their own so that a scene without it pays nothing */
     real T40 = 0, T31 = 0, T22 = 0, T13 = 0, T04 = 0;
     real Q30 = 0, Q21 = 0, Q12 = 0, Q03 = 0, P30 = 0, P21 = 0, P12 = 0, P03 = 0;
-    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
       RHOD_SIMD(reduction(+ : T40, T31, T22, T13, T04, Q30, Q21, Q12, Q03, P30, P21, P12, P03))
-      for (int k = k0; k < k1; k++) {
+      for (int k = k0; k < kv; k++) {
         PAIR_OR_SKIP(k);
         const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
         const real exx = nx * nx, exy = nx * ny, eyy = ny * ny, a = F * r, b = F * r2;
@@ -511,9 +511,9 @@ PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
              *knx = pk + PK_NX * st, *kny = pk + PK_NY * st;
   const real iR = 1 / Ri;
   real sx = 0, sy = 0, dmin2 = R2, any = 0;
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
     RHOD_SIMD(reduction(+ : sx, sy) reduction(min : dmin2) reduction(max : any))
-    for (int k = k0; k < k1; k++) {
+    for (int k = k0; k < kv; k++) {
       const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
       if (!(r2 < R2 && kf[k] > 0))
         continue;
@@ -728,9 +728,9 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   real cont = 0;                              /* continuity, Eq. 22 */
   real vsx = 0, vsy = 0;                      /* F^mu */
   real ddu = 0, drdu = 0, ruux = 0, ruuy = 0; /* Eq. 4 */
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
     RHOD_SIMD(reduction(+ : vRx, vRy, vCx, vCy, sfx, sfy, cont, vsx, vsy, ddu, drdu, ruux, ruuy))
-    for (int k = k0; k < k1; k++) {
+    for (int k = k0; k < kv; k++) {
       PAIR_OR_SKIP(k);
       const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k]; /* |grad_i W_ij| V_j */
       const real fx = F * nx, fy = F * ny;
@@ -1016,9 +1016,9 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
     const real iR = 1 / Ri, iR3 = iR * iR * iR, vxi = v[2 * i], vyi = v[2 * i + 1];
     real B0 = 0, B1 = 0, B2 = 0, B3 = 0, G0 = 0, G1 = 0, G2 = 0, G3 = 0;
-    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
       RHOD_SIMD(reduction(+ : B0, B1, B2, B3, G0, G1, G2, G3))
-      for (int k = k0; k < k1; k++) {
+      for (int k = k0; k < kv; k++) {
         PAIR_OR_SKIP(k);
         const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
         const real gwx = F * nx, gwy = F * ny, dvx = kvx[k] - vxi, dvy = kvy[k] - vyi;
@@ -1060,9 +1060,9 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri, Di = aD[i];
     const real iR = 1 / Ri, iR3 = iR * iR * iR;
     real fx = 0, fy = 0;
-    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
       RHOD_SIMD(reduction(+ : fx, fy))
-      for (int k = k0; k < k1; k++) {
+      for (int k = k0; k < kv; k++) {
         PAIR_OR_SKIP(k);
         const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k] * (kD[k] + Di);
         fx += F * nx, fy += F * ny;

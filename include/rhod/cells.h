@@ -97,7 +97,7 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
  * around (xi, yi) that can lie within Ri (the gathering particle's radius); the body
  * tests the distance against it. */
 #define RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j)                                              \
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0_, k1_)                                                       \
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0_, k1_, kv_)                                                  \
   for (int k_ = k0_; k_ < k1_; k_++) {                                                             \
     const int j = (CI)[k_];
 #define RHOD_END_NEIGHBOURS                                                                        \
@@ -106,11 +106,28 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
 
 /* The same scan as ranges: for each row of cells, [k0, k1) is its contiguous range of
  * the sorted index (particle CI[k] for k in it). Loops that vectorise over k read
- * copies of the fields packed in this order (rhod_sph's pk arrays):
+ * copies of the fields packed in this order (rhod_sph's pk arrays), and run to kv:
+ * where they vectorise (RHOD_VLANES > 1, config.h), k1 rounded up to whole vectors from
+ * k0 but not past the end of the window's row of cells; elsewhere k1. The candidates
+ * in [k1, kv) are in the row's cells to the right of the scanned ones, so farther from
+ * xi than rc cells = ceil(R/R0 - 1e-4) R0, i.e. than R less the 1e-4 R0 that
+ * rhod_cell_reach already leaves out: the body's own test r < R rejects them, no
+ * extra test is needed, and none is counted twice (each row is scanned once):
  *
- *   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1) {
- *     RHOD_SIMD(reduction(+ : sum)) for (int k = k0; k < k1; k++) ... } RHOD_END_ROWS */
-#define RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1)                                                   \
+ *   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+ *     RHOD_SIMD(reduction(+ : sum)) for (int k = k0; k < kv; k++) {
+ *       if (!(r2 < R2)) continue; ... } } RHOD_END_ROWS */
+#if RHOD_VLANES > 1
+#define RHOD_ROW_END_(k0, k1, kn)                                                                  \
+  const int kv_r_ = (k0) + ((k1) - (k0) + RHOD_VLANES - 1) / RHOD_VLANES * RHOD_VLANES;            \
+  const int kv = kv_r_ < (kn) ? kv_r_ : (kn);                                                      \
+  (void)kv;
+#else
+#define RHOD_ROW_END_(k0, k1, kn)                                                                  \
+  const int kv = (k1);                                                                             \
+  (void)kv;
+#endif
+#define RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv)                                               \
   {                                                                                                \
     const int rc_ = rhod_cell_reach((G), (Ri));                                                    \
     const int cx_ = rhod_cell_coord((xi), (G).ox, (G).inv, (G).cx0, (G).nx);                       \
@@ -120,7 +137,8 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
     const int x0_ = cx_ - rc_ > 0 ? cx_ - rc_ : 0;                                                 \
     const int x1_ = cx_ + rc_ < (G).nx - 1 ? cx_ + rc_ : (G).nx - 1;                               \
     for (int yy_ = y0_; yy_ <= y1_; yy_++) {                                                       \
-      const int k0 = (CS)[yy_ * (G).nx + x0_], k1 = (CS)[yy_ * (G).nx + x1_ + 1];
+      const int k0 = (CS)[yy_ * (G).nx + x0_], k1 = (CS)[yy_ * (G).nx + x1_ + 1];                  \
+      RHOD_ROW_END_(k0, k1, (CS)[yy_ * (G).nx + (G).nx])
 #define RHOD_END_ROWS                                                                              \
   }                                                                                                \
   }

@@ -54,9 +54,25 @@ typedef double real;
 #define RHOD_PRAGMA_V(...) _Pragma(#__VA_ARGS__)
 #if defined(__AVX2__)
 #define RHOD_SIMD(...) RHOD_PRAGMA_V(omp simd __VA_ARGS__)
+/* Lanes of the vectors GCC uses for those loops (512 or 256 bits). RHOD_FOR_ROWS pads a
+ * row's range to whole vectors of them (cells.h), so that no candidate is left to the
+ * scalar loop GCC 12 runs after a vector loop for the remainder (it has no masked one on
+ * x86). A row holds about 10 candidates, and near a free surface fewer: with AVX-512 the
+ * dam break spent a third of pass C in that scalar loop (perf/RESULTS.md "Rows padded
+ * to whole vectors"). */
+#if defined(__AVX512F__) && defined(RHOD_SINGLE)
+#define RHOD_VLANES 16
+#elif defined(__AVX512F__) || defined(RHOD_SINGLE)
+#define RHOD_VLANES 8
+#else
+#define RHOD_VLANES 4
+#endif
 #else
 #define RHOD_SIMD(...)
 #endif
+#endif
+#ifndef RHOD_VLANES
+#define RHOD_VLANES 1
 #endif
 
 #endif
