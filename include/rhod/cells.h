@@ -105,18 +105,14 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
   RHOD_END_ROWS
 
 /* The same scan as ranges: for each row of cells, [k0, k1) is its contiguous range of
- * the sorted index (particle CI[k] for k in it). Loops that vectorise over k read
- * copies of the fields packed in this order (rhod_sph's pk arrays), and run to kv:
- * where they vectorise (RHOD_VLANES > 1, config.h), k1 rounded up to whole vectors from
- * k0 but not past the end of the window's row of cells; elsewhere k1. The candidates
- * in [k1, kv) are in the row's cells to the right of the scanned ones, so farther from
- * xi than rc cells = ceil(R/R0 - 1e-4) R0, i.e. than R less the 1e-4 R0 that
- * rhod_cell_reach already leaves out: the body's own test r < R rejects them, no
- * extra test is needed, and none is counted twice (each row is scanned once):
- *
- *   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
- *     RHOD_SIMD(reduction(+ : sum)) for (int k = k0; k < kv; k++) {
- *       if (!(r2 < R2)) continue; ... } } RHOD_END_ROWS */
+ * the sorted index (particle CI[k] for k in it). The gathers read copies of the fields
+ * packed in this order (rhod_sph's pk arrays) and run to kv: where they vectorise
+ * (RHOD_VLANES > 1, config.h), k1 rounded up to whole vectors from k0 but not past the
+ * end of the window's row of cells; elsewhere k1. The candidates in [k1, kv) are in the
+ * row's cells to the right of the scanned ones, so farther from xi than rc cells =
+ * ceil(R/R0 - 1e-4) R0, i.e. than R less the 1e-4 R0 that rhod_cell_reach already leaves
+ * out: the body's own test r < R rejects them, no extra test is needed, and none is
+ * counted twice (each row is scanned once). */
 #if RHOD_VLANES > 1
 #define RHOD_ROW_END_(k0, k1, kn)                                                                  \
   const int kv_r_ = (k0) + ((k1) - (k0) + RHOD_VLANES - 1) / RHOD_VLANES * RHOD_VLANES;            \
@@ -142,6 +138,79 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
 #define RHOD_END_ROWS                                                                              \
   }                                                                                                \
   }
+
+/* A gather's sums, kept per vector lane. On the host with RHOD_VLANES > 1 each sum is an
+ * array of one partial sum per lane; the candidates of a row are taken a vector at a
+ * time (an `omp simd` loop of RHOD_VLANES lanes, lane l adding to its own element), and
+ * the lanes are added once, after the last row. An `omp simd reduction` over each row
+ * instead adds its lanes at the end of every row: with AVX-512, 8 lanes times 17 sums
+ * of pass A, five to 33 times per particle, which took half of pass A
+ * (perf/RESULTS.md "Gather sums kept per lane"). A vector whose candidates are all
+ * outside the support costs a distance test. Elsewhere (the device, whose lanes are
+ * particles, or a host without vectors) each sum is a plain scalar and the loop a
+ * plain loop over [k0, kv):
+ *
+ *   real RHOD_LANES(s);                  (declared and set to 0; RHOD_LANES_SET(s, v) sets v)
+ *   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+ *     RHOD_FOR_LANES(k0, kv, k) {
+ *       if (!(r2 < R2)) continue;
+ *       RHOD_LANE(s) += ...;
+ *     } RHOD_END_LANES
+ *   } RHOD_END_ROWS
+ *   const real sum = RHOD_LANES_SUM(s);
+ *
+ * The order of the additions differs between the two, so their sums differ in the last
+ * digits; each is the same from run to run. */
+#if RHOD_VLANES > 1
+#define RHOD_LANES(s) s[RHOD_VLANES] = {0}
+#define RHOD_LANE(s) s[l_]
+#define RHOD_LANES_SET(s, v)                                                                       \
+  for (int l_ = 0; l_ < RHOD_VLANES; l_++)                                                         \
+  s[l_] = (v)
+#define RHOD_FOR_LANES(k0, kv, k)                                                                  \
+  for (int m_ = (k0); m_ < (kv); m_ += RHOD_VLANES) {                                              \
+    const int n_ = (kv)-m_ < RHOD_VLANES ? (kv)-m_ : RHOD_VLANES;                                  \
+    RHOD_PRAGMA(omp simd)                                                                          \
+    for (int l_ = 0; l_ < n_; l_++) {                                                              \
+      const int k = m_ + l_;
+#define RHOD_END_LANES                                                                             \
+  }                                                                                                \
+  }
+#define RHOD_LANES_SUM(s) rhod_lanes_sum_(s)
+#define RHOD_LANES_MAX(s) rhod_lanes_max_(s)
+#define RHOD_LANES_MIN(s) rhod_lanes_min_(s)
+static inline real rhod_lanes_sum_(const real *s) {
+  real t = 0;
+  for (int l = 0; l < RHOD_VLANES; l++)
+    t += s[l];
+  return t;
+}
+static inline real rhod_lanes_max_(const real *s) {
+  real t = s[0];
+  for (int l = 1; l < RHOD_VLANES; l++)
+    t = s[l] > t ? s[l] : t;
+  return t;
+}
+static inline real rhod_lanes_min_(const real *s) {
+  real t = s[0];
+  for (int l = 1; l < RHOD_VLANES; l++)
+    t = s[l] < t ? s[l] : t;
+  return t;
+}
+#else
+#define RHOD_LANES(s) s = 0
+#define RHOD_LANE(s) s
+#define RHOD_LANES_SET(s, v) s = (v)
+#define RHOD_FOR_LANES(k0, kv, k)                                                                  \
+  {                                                                                                \
+    for (int k = (k0); k < (kv); k++) {
+#define RHOD_END_LANES                                                                             \
+  }                                                                                                \
+  }
+#define RHOD_LANES_SUM(s) (s)
+#define RHOD_LANES_MAX(s) (s)
+#define RHOD_LANES_MIN(s) (s)
+#endif
 
 /* 1 when a cell within reach of a support of radius R at (x, y) is marked (inside
  * device regions: pass a local copy of c->mark). */

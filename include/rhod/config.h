@@ -32,8 +32,8 @@ typedef double real;
 /* RHOD_GATHER_LOOP: a loop over particles whose work per particle varies (a gather over
  * the support): on the device as RHOD_KERNEL_LOOP. */
 #define RHOD_GATHER_LOOP RHOD_KERNEL_LOOP
-/* On the device the particle loop is already the simd loop (one particle per lane). */
-#define RHOD_SIMD(...)
+/* On the device the particle loop is already the simd loop (one particle per lane), so a
+ * gather's loop over candidates is a plain one: RHOD_VLANES is 1 (below). */
 #else
 #define RHOD_PRAGMA(x) _Pragma(#x)
 #define RHOD_KERNEL_LOOP RHOD_PRAGMA(omp parallel for schedule(static))
@@ -47,19 +47,12 @@ typedef double real;
   RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : var))
 #define RHOD_KERNEL_LOOP_REDUCE2(op, v1, v2)                                                       \
   RHOD_PRAGMA(omp parallel for schedule(static) reduction(op : v1, v2))
-/* RHOD_SIMD(clauses) vectorises a gather's inner loop over neighbours on the host
- * (clauses: the reductions of its sums). Only where the CPU has masked vector loads
- * (AVX2 and up, e.g. with -DRHOD_NATIVE=ON): without them the masked loop is slower
- * than the scalar one, which skips the candidates outside the support (perf/RESULTS.md). */
-#define RHOD_PRAGMA_V(...) _Pragma(#__VA_ARGS__)
+/* RHOD_VLANES: the lanes of the vectors in which a gather takes its candidates on the
+ * host (cells.h, RHOD_FOR_LANES), those GCC uses for them (512 or 256 bits). Only where
+ * the CPU has masked vector loads (AVX2 and up, e.g. with -DRHOD_NATIVE=ON): without
+ * them the masked loop is slower than the scalar one, which skips the candidates
+ * outside the support (perf/RESULTS.md), and RHOD_VLANES is 1. */
 #if defined(__AVX2__)
-#define RHOD_SIMD(...) RHOD_PRAGMA_V(omp simd __VA_ARGS__)
-/* Lanes of the vectors GCC uses for those loops (512 or 256 bits). RHOD_FOR_ROWS pads a
- * row's range to whole vectors of them (cells.h), so that no candidate is left to the
- * scalar loop GCC 12 runs after a vector loop for the remainder (it has no masked one on
- * x86). A row holds about 10 candidates, and near a free surface fewer: with AVX-512 the
- * dam break spent a third of pass C in that scalar loop (perf/RESULTS.md "Rows padded
- * to whole vectors"). */
 #if defined(__AVX512F__) && defined(RHOD_SINGLE)
 #define RHOD_VLANES 16
 #elif defined(__AVX512F__) || defined(RHOD_SINGLE)
@@ -67,8 +60,6 @@ typedef double real;
 #else
 #define RHOD_VLANES 4
 #endif
-#else
-#define RHOD_SIMD(...)
 #endif
 #endif
 #ifndef RHOD_VLANES
