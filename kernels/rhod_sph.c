@@ -236,125 +236,129 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
       RHOD_LANES(sB2), RHOD_LANES(sB3), RHOD_LANES(sGPx), RHOD_LANES(sGPy), RHOD_LANES(sGu0),
       RHOD_LANES(sGu1), RHOD_LANES(sGu2), RHOD_LANES(sGu3), RHOD_LANES(scx), RHOD_LANES(scy),
       RHOD_LANES(sum);
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv){RHOD_FOR_LANES(k0, kv, k){PAIR_OR_SKIP(k);
-  const real Vj = kV[k];
-  const real q = r * iR;
-  const real F = -rhod_dWq(kern, q) * iR3 * Vj; /* |grad_i W_ij| V_j */
-  const real Wq = rhod_Wq(kern, q), Wv = Wq * iR2 * Vj;
-  const real gwx = F * nx, gwy = F * ny;
-  RHOD_LANE(sg) += Wv;                                    /* Eq. 7 */
-  RHOD_LANE(sggx) += gwx, RHOD_LANE(sggy) += gwy;         /* Eq. 27 */
-  RHOD_LANE(sB0) += rx * gwx, RHOD_LANE(sB1) += rx * gwy; /* Eq. 8: B_ab = sum r_a g_b V */
-  RHOD_LANE(sB2) += ry * gwx, RHOD_LANE(sB3) += ry * gwy;
-  const real dP = kP[k] - Pi, dux = kux[k] - uxi, duy = kuy[k] - uyi;
-  RHOD_LANE(sGPx) += dP * gwx, RHOD_LANE(sGPy) += dP * gwy; /* Eq. 14, raw */
-  RHOD_LANE(sGu0) += dux * gwx, RHOD_LANE(sGu1) += dux * gwy;
-  RHOD_LANE(sGu2) += duy * gwx, RHOD_LANE(sGu3) += duy * gwy;
-  /* Eq. 29: [1 + 0.2 (W_ij / W(dx_ij))^4] grad_i W_ij V_j, W(dx_ij) with R_i */
-  const real dxj = kdx[k];
-  const real wr = dxj == dxi ? Wq * iWdx : Wq / rhod_Wq(kern, (real)0.5 * (dxi + dxj) * iR);
-  const real f = 1 + (real)0.2 * wr * wr * wr * wr;
-  RHOD_LANE(scx) += f * gwx, RHOD_LANE(scy) += f * gwy;
-  const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
-  RHOD_LANE(sum) = un > RHOD_LANE(sum) ? un : RHOD_LANE(sum);
-}
-RHOD_END_LANES
-}
-RHOD_END_ROWS
-const real g = rhod_Wq(kern, 0) * iR2 * V[i] + RHOD_LANES_SUM(sg); /* Eq. 7, self term too */
-const real ggx = RHOD_LANES_SUM(sggx), ggy = RHOD_LANES_SUM(sggy);
-const real B0 = RHOD_LANES_SUM(sB0), B1 = RHOD_LANES_SUM(sB1), B2 = RHOD_LANES_SUM(sB2),
-           B3 = RHOD_LANES_SUM(sB3);
-const real GPx = RHOD_LANES_SUM(sGPx), GPy = RHOD_LANES_SUM(sGPy);
-const real Gu0 = RHOD_LANES_SUM(sGu0), Gu1 = RHOD_LANES_SUM(sGu1), Gu2 = RHOD_LANES_SUM(sGu2),
-           Gu3 = RHOD_LANES_SUM(sGu3);
-const real cx = RHOD_LANES_SUM(scx), cy = RHOD_LANES_SUM(scy), um = RHOD_LANES_MAX(sum);
-const real div = Gu0 + Gu3; /* Eq. 5: sum (u_j - u_i) . grad_i W_ij V_j, the trace */
-gam[i] = g;
-ggam[2 * i] = ggx, ggam[2 * i + 1] = ggy;
-D[i] = div;
-gC[2 * i] = cx, gC[2 * i + 1] = cy;
-uch[i] = um;
-const real Bm[4] = {B0, B1, B2, B3};
-lam[i] = rhod_min_eig_sym(Bm);
-/* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
- * invert: isolated particles, thin jets) L = identity, so the gradients fall
- * back to the plain SPH sums. */
-const real det = B0 * B3 - B1 * B2;
-real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
-if (det > (real)1e-2) {
-  const real id = 1 / det;
-  L0 = B3 * id, L1 = -B1 * id, L2 = -B2 * id, L3 = B0 * id;
-}
-L[4 * i] = L0, L[4 * i + 1] = L1, L[4 * i + 2] = L2, L[4 * i + 3] = L3;
-/* exact for linear fields: sum (a.r) g V = B^T a, so grad = L^T G (scheme.md) */
-gP[2 * i] = L0 * GPx + L2 * GPy;
-gP[2 * i + 1] = L1 * GPx + L3 * GPy;
-gu[4 * i] = L0 * Gu0 + L2 * Gu1;
-gu[4 * i + 1] = L1 * Gu0 + L3 * Gu1;
-gu[4 * i + 2] = L0 * Gu2 + L2 * Gu3;
-gu[4 * i + 3] = L1 * Gu2 + L3 * Gu3;
-if (vcons) {
-  /* moments of the consistent Laplacian: T = sum F r n n n n, Q = sum F n n n, P3 =
-   * sum F r^2 n n n (fully symmetric; digits count the x and y indices), in a loop of
-   * their own so that a scene without it pays nothing */
-  real RHOD_LANES(s40), RHOD_LANES(s31), RHOD_LANES(s22), RHOD_LANES(s13), RHOD_LANES(s04);
-  real RHOD_LANES(q30), RHOD_LANES(q21), RHOD_LANES(q12), RHOD_LANES(q03);
-  real RHOD_LANES(p30), RHOD_LANES(p21), RHOD_LANES(p12), RHOD_LANES(p03);
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv){RHOD_FOR_LANES(k0, kv, k){PAIR_OR_SKIP(k);
-  const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
-  const real exx = nx * nx, exy = nx * ny, eyy = ny * ny, a = F * r, b = F * r2;
-  RHOD_LANE(s40) += a * exx * exx, RHOD_LANE(s31) += a * exx * exy;
-  RHOD_LANE(s22) += a * exx * eyy, RHOD_LANE(s13) += a * exy * eyy;
-  RHOD_LANE(s04) += a * eyy * eyy;
-  RHOD_LANE(q30) += F * exx * nx, RHOD_LANE(q21) += F * exx * ny;
-  RHOD_LANE(q12) += F * eyy * nx, RHOD_LANE(q03) += F * eyy * ny;
-  RHOD_LANE(p30) += b * exx * nx, RHOD_LANE(p21) += b * exx * ny;
-  RHOD_LANE(p12) += b * eyy * nx, RHOD_LANE(p03) += b * eyy * ny;
-}
-RHOD_END_LANES
-}
-RHOD_END_ROWS
-const real T40 = RHOD_LANES_SUM(s40), T31 = RHOD_LANES_SUM(s31), T22 = RHOD_LANES_SUM(s22),
-           T13 = RHOD_LANES_SUM(s13), T04 = RHOD_LANES_SUM(s04);
-const real Q30 = RHOD_LANES_SUM(q30), Q21 = RHOD_LANES_SUM(q21), Q12 = RHOD_LANES_SUM(q12),
-           Q03 = RHOD_LANES_SUM(q03);
-const real P30 = RHOD_LANES_SUM(p30), P21 = RHOD_LANES_SUM(p21), P12 = RHOD_LANES_SUM(p12),
-           P03 = RHOD_LANES_SUM(p03);
-/* The consistent Laplacian (our choice for scheme.viscosity: consistent, in the
- * manner of Fatehi & Manzari 2011; paper 002 names such higher-order operators
- * after Eq. 10 without giving one): lap f_i = B^ : sum_j 2 F n n ((f_j - f_i)/r -
- * n . grad f_i), grad f the renormalised gradient above. A Taylor expansion gives
- * sum = T' : H with T'_abcd = T_abcd - Q_abm M_mcd, M = L^T P3 (the gradient's
- * own error on a quadratic field), so B^ solves B^_ab T'_abcd = delta_cd and the
- * operator is exact for quadratic fields on any cloud (tests/test_kernels.c). On
- * a lattice T' = (delta delta + 2 sym) / 4 and B^ = I. */
-const real Mx0 = L0 * P30 + L2 * P21, Mx1 = L0 * P21 + L2 * P12, Mx2 = L0 * P12 + L2 * P03;
-const real My0 = L1 * P30 + L3 * P21, My1 = L1 * P21 + L3 * P12, My2 = L1 * P12 + L3 * P03;
-/* T'_(ab)(cd), ab and cd in xx (0), xy (1), yy (2) */
-const real t00 = T40 - (Q30 * Mx0 + Q21 * My0), t01 = T31 - (Q30 * Mx1 + Q21 * My1),
-           t02 = T22 - (Q30 * Mx2 + Q21 * My2);
-const real t10 = T31 - (Q21 * Mx0 + Q12 * My0), t11 = T22 - (Q21 * Mx1 + Q12 * My1),
-           t12 = T13 - (Q21 * Mx2 + Q12 * My2);
-const real t20 = T22 - (Q12 * Mx0 + Q03 * My0), t21 = T13 - (Q12 * Mx1 + Q03 * My1),
-           t22 = T04 - (Q12 * Mx2 + Q03 * My2);
-/* rows cd = xx, yy, xy; unknowns (B^xx, B^xy, B^yy); right side (1, 1, 0) */
-const real a00 = t00, a01 = 2 * t10, a02 = t20;
-const real a10 = t02, a11 = 2 * t12, a12 = t22;
-const real a20 = t01, a21 = 2 * t11, a22 = t21;
-const real det =
-    a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) + a02 * (a10 * a21 - a11 * a20);
-real bxx = 0, bxy = 0, byy = 0;
-/* our choice: |det| below a tenth of the full support's 1/4 leaves B^ = 0, and
- * pass C uses Eq. 10 for that particle */
-if (fabs(det) > (real)0.025) {
-  const real id = 1 / det;
-  bxx = ((a11 * a22 - a12 * a21) - (a01 * a22 - a02 * a21)) * id;
-  bxy = ((a00 * a22 - a02 * a20) - (a10 * a22 - a12 * a20)) * id;
-  byy = ((a10 * a21 - a11 * a20) - (a00 * a21 - a01 * a20)) * id;
-}
-lapB[3 * i] = bxx, lapB[3 * i + 1] = bxy, lapB[3 * i + 2] = byy;
-}
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+    RHOD_FOR_LANES(k0, kv, k) {
+      PAIR_OR_SKIP(k);
+      const real Vj = kV[k];
+      const real q = r * iR;
+      const real F = -rhod_dWq(kern, q) * iR3 * Vj; /* |grad_i W_ij| V_j */
+      const real Wq = rhod_Wq(kern, q), Wv = Wq * iR2 * Vj;
+      const real gwx = F * nx, gwy = F * ny;
+      RHOD_LANE(sg) += Wv;                                    /* Eq. 7 */
+      RHOD_LANE(sggx) += gwx, RHOD_LANE(sggy) += gwy;         /* Eq. 27 */
+      RHOD_LANE(sB0) += rx * gwx, RHOD_LANE(sB1) += rx * gwy; /* Eq. 8: B_ab = sum r_a g_b V */
+      RHOD_LANE(sB2) += ry * gwx, RHOD_LANE(sB3) += ry * gwy;
+      const real dP = kP[k] - Pi, dux = kux[k] - uxi, duy = kuy[k] - uyi;
+      RHOD_LANE(sGPx) += dP * gwx, RHOD_LANE(sGPy) += dP * gwy; /* Eq. 14, raw */
+      RHOD_LANE(sGu0) += dux * gwx, RHOD_LANE(sGu1) += dux * gwy;
+      RHOD_LANE(sGu2) += duy * gwx, RHOD_LANE(sGu3) += duy * gwy;
+      /* Eq. 29: [1 + 0.2 (W_ij / W(dx_ij))^4] grad_i W_ij V_j, W(dx_ij) with R_i */
+      const real dxj = kdx[k];
+      const real wr = dxj == dxi ? Wq * iWdx : Wq / rhod_Wq(kern, (real)0.5 * (dxi + dxj) * iR);
+      const real f = 1 + (real)0.2 * wr * wr * wr * wr;
+      RHOD_LANE(scx) += f * gwx, RHOD_LANE(scy) += f * gwy;
+      const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
+      RHOD_LANE(sum) = un > RHOD_LANE(sum) ? un : RHOD_LANE(sum);
+    }
+    RHOD_END_LANES
+  }
+  RHOD_END_ROWS
+  const real g = rhod_Wq(kern, 0) * iR2 * V[i] + RHOD_LANES_SUM(sg); /* Eq. 7, self term too */
+  const real ggx = RHOD_LANES_SUM(sggx), ggy = RHOD_LANES_SUM(sggy);
+  const real B0 = RHOD_LANES_SUM(sB0), B1 = RHOD_LANES_SUM(sB1), B2 = RHOD_LANES_SUM(sB2),
+             B3 = RHOD_LANES_SUM(sB3);
+  const real GPx = RHOD_LANES_SUM(sGPx), GPy = RHOD_LANES_SUM(sGPy);
+  const real Gu0 = RHOD_LANES_SUM(sGu0), Gu1 = RHOD_LANES_SUM(sGu1), Gu2 = RHOD_LANES_SUM(sGu2),
+             Gu3 = RHOD_LANES_SUM(sGu3);
+  const real cx = RHOD_LANES_SUM(scx), cy = RHOD_LANES_SUM(scy), um = RHOD_LANES_MAX(sum);
+  const real div = Gu0 + Gu3; /* Eq. 5: sum (u_j - u_i) . grad_i W_ij V_j, the trace */
+  gam[i] = g;
+  ggam[2 * i] = ggx, ggam[2 * i + 1] = ggy;
+  D[i] = div;
+  gC[2 * i] = cx, gC[2 * i + 1] = cy;
+  uch[i] = um;
+  const real Bm[4] = {B0, B1, B2, B3};
+  lam[i] = rhod_min_eig_sym(Bm);
+  /* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
+   * invert: isolated particles, thin jets) L = identity, so the gradients fall
+   * back to the plain SPH sums. */
+  const real det = B0 * B3 - B1 * B2;
+  real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
+  if (det > (real)1e-2) {
+    const real id = 1 / det;
+    L0 = B3 * id, L1 = -B1 * id, L2 = -B2 * id, L3 = B0 * id;
+  }
+  L[4 * i] = L0, L[4 * i + 1] = L1, L[4 * i + 2] = L2, L[4 * i + 3] = L3;
+  /* exact for linear fields: sum (a.r) g V = B^T a, so grad = L^T G (scheme.md) */
+  gP[2 * i] = L0 * GPx + L2 * GPy;
+  gP[2 * i + 1] = L1 * GPx + L3 * GPy;
+  gu[4 * i] = L0 * Gu0 + L2 * Gu1;
+  gu[4 * i + 1] = L1 * Gu0 + L3 * Gu1;
+  gu[4 * i + 2] = L0 * Gu2 + L2 * Gu3;
+  gu[4 * i + 3] = L1 * Gu2 + L3 * Gu3;
+  if (vcons) {
+    /* moments of the consistent Laplacian: T = sum F r n n n n, Q = sum F n n n, P3 =
+     * sum F r^2 n n n (fully symmetric; digits count the x and y indices), in a loop of
+     * their own so that a scene without it pays nothing */
+    real RHOD_LANES(s40), RHOD_LANES(s31), RHOD_LANES(s22), RHOD_LANES(s13), RHOD_LANES(s04);
+    real RHOD_LANES(q30), RHOD_LANES(q21), RHOD_LANES(q12), RHOD_LANES(q03);
+    real RHOD_LANES(p30), RHOD_LANES(p21), RHOD_LANES(p12), RHOD_LANES(p03);
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+      RHOD_FOR_LANES(k0, kv, k) {
+        PAIR_OR_SKIP(k);
+        const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
+        const real exx = nx * nx, exy = nx * ny, eyy = ny * ny, a = F * r, b = F * r2;
+        RHOD_LANE(s40) += a * exx * exx, RHOD_LANE(s31) += a * exx * exy;
+        RHOD_LANE(s22) += a * exx * eyy, RHOD_LANE(s13) += a * exy * eyy;
+        RHOD_LANE(s04) += a * eyy * eyy;
+        RHOD_LANE(q30) += F * exx * nx, RHOD_LANE(q21) += F * exx * ny;
+        RHOD_LANE(q12) += F * eyy * nx, RHOD_LANE(q03) += F * eyy * ny;
+        RHOD_LANE(p30) += b * exx * nx, RHOD_LANE(p21) += b * exx * ny;
+        RHOD_LANE(p12) += b * eyy * nx, RHOD_LANE(p03) += b * eyy * ny;
+      }
+      RHOD_END_LANES
+    }
+    RHOD_END_ROWS
+    const real T40 = RHOD_LANES_SUM(s40), T31 = RHOD_LANES_SUM(s31), T22 = RHOD_LANES_SUM(s22),
+               T13 = RHOD_LANES_SUM(s13), T04 = RHOD_LANES_SUM(s04);
+    const real Q30 = RHOD_LANES_SUM(q30), Q21 = RHOD_LANES_SUM(q21), Q12 = RHOD_LANES_SUM(q12),
+               Q03 = RHOD_LANES_SUM(q03);
+    const real P30 = RHOD_LANES_SUM(p30), P21 = RHOD_LANES_SUM(p21), P12 = RHOD_LANES_SUM(p12),
+               P03 = RHOD_LANES_SUM(p03);
+    /* The consistent Laplacian (our choice for scheme.viscosity: consistent, in the
+     * manner of Fatehi & Manzari 2011; paper 002 names such higher-order operators
+     * after Eq. 10 without giving one): lap f_i = B^ : sum_j 2 F n n ((f_j - f_i)/r -
+     * n . grad f_i), grad f the renormalised gradient above. A Taylor expansion gives
+     * sum = T' : H with T'_abcd = T_abcd - Q_abm M_mcd, M = L^T P3 (the gradient's
+     * own error on a quadratic field), so B^ solves B^_ab T'_abcd = delta_cd and the
+     * operator is exact for quadratic fields on any cloud (tests/test_kernels.c). On
+     * a lattice T' = (delta delta + 2 sym) / 4 and B^ = I. */
+    const real Mx0 = L0 * P30 + L2 * P21, Mx1 = L0 * P21 + L2 * P12, Mx2 = L0 * P12 + L2 * P03;
+    const real My0 = L1 * P30 + L3 * P21, My1 = L1 * P21 + L3 * P12, My2 = L1 * P12 + L3 * P03;
+    /* T'_(ab)(cd), ab and cd in xx (0), xy (1), yy (2) */
+    const real t00 = T40 - (Q30 * Mx0 + Q21 * My0), t01 = T31 - (Q30 * Mx1 + Q21 * My1),
+               t02 = T22 - (Q30 * Mx2 + Q21 * My2);
+    const real t10 = T31 - (Q21 * Mx0 + Q12 * My0), t11 = T22 - (Q21 * Mx1 + Q12 * My1),
+               t12 = T13 - (Q21 * Mx2 + Q12 * My2);
+    const real t20 = T22 - (Q12 * Mx0 + Q03 * My0), t21 = T13 - (Q12 * Mx1 + Q03 * My1),
+               t22 = T04 - (Q12 * Mx2 + Q03 * My2);
+    /* rows cd = xx, yy, xy; unknowns (B^xx, B^xy, B^yy); right side (1, 1, 0) */
+    const real a00 = t00, a01 = 2 * t10, a02 = t20;
+    const real a10 = t02, a11 = 2 * t12, a12 = t22;
+    const real a20 = t01, a21 = 2 * t11, a22 = t21;
+    const real det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) +
+                     a02 * (a10 * a21 - a11 * a20);
+    real bxx = 0, bxy = 0, byy = 0;
+    /* our choice: |det| below a tenth of the full support's 1/4 leaves B^ = 0, and
+     * pass C uses Eq. 10 for that particle */
+    if (fabs(det) > (real)0.025) {
+      const real id = 1 / det;
+      bxx = ((a11 * a22 - a12 * a21) - (a01 * a22 - a02 * a21)) * id;
+      bxy = ((a00 * a22 - a02 * a20) - (a10 * a22 - a12 * a20)) * id;
+      byy = ((a10 * a21 - a11 * a20) - (a00 * a21 - a01 * a20)) * id;
+    }
+    lapB[3 * i] = bxx, lapB[3 * i + 1] = bxy, lapB[3 * i + 2] = byy;
+  }
 }
 
 void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
@@ -526,31 +530,32 @@ PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
   const real iR = 1 / Ri;
   real RHOD_LANES(ssx), RHOD_LANES(ssy), RHOD_LANES(sd2), RHOD_LANES(sany);
   RHOD_LANES_SET(sd2, R2);
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv){
-      RHOD_FOR_LANES(k0, kv, k){const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
-  if (!(r2 < R2 && kf[k] > 0))
-    continue;
-  const real w = rhod_Wq(kern, sqrt(r2) * iR); /* W R^2: nt is normalised below */
-  RHOD_LANE(ssx) += w * knx[k], RHOD_LANE(ssy) += w * kny[k];
-  const real d2 = r2 > 0 ? r2 : R2;
-  RHOD_LANE(sd2) = d2 < RHOD_LANE(sd2) ? d2 : RHOD_LANE(sd2);
-  RHOD_LANE(sany) = 1;
-}
-RHOD_END_LANES
-}
-RHOD_END_ROWS
-const real sx = RHOD_LANES_SUM(ssx), sy = RHOD_LANES_SUM(ssy);
-const real dmin2 = RHOD_LANES_MIN(sd2), any = RHOD_LANES_MAX(sany);
-const real sn = sqrt(sx * sx + sy * sy);
-if (fs[i]) {
-  reg[i] = 2, sig[i] = 1;
-} else if (any > 0) {
-  reg[i] = 1, sig[i] = 1 - sqrt(dmin2) / Ri;
-} else {
-  reg[i] = 0, sig[i] = 0;
-}
-nt[2 * i] = sn > 0 ? sx / sn : 0;
-nt[2 * i + 1] = sn > 0 ? sy / sn : 0;
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+    RHOD_FOR_LANES(k0, kv, k) {
+      const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
+      if (!(r2 < R2 && kf[k] > 0))
+        continue;
+      const real w = rhod_Wq(kern, sqrt(r2) * iR); /* W R^2: nt is normalised below */
+      RHOD_LANE(ssx) += w * knx[k], RHOD_LANE(ssy) += w * kny[k];
+      const real d2 = r2 > 0 ? r2 : R2;
+      RHOD_LANE(sd2) = d2 < RHOD_LANE(sd2) ? d2 : RHOD_LANE(sd2);
+      RHOD_LANE(sany) = 1;
+    }
+    RHOD_END_LANES
+  }
+  RHOD_END_ROWS
+  const real sx = RHOD_LANES_SUM(ssx), sy = RHOD_LANES_SUM(ssy);
+  const real dmin2 = RHOD_LANES_MIN(sd2), any = RHOD_LANES_MAX(sany);
+  const real sn = sqrt(sx * sx + sy * sy);
+  if (fs[i]) {
+    reg[i] = 2, sig[i] = 1;
+  } else if (any > 0) {
+    reg[i] = 1, sig[i] = 1 - sqrt(dmin2) / Ri;
+  } else {
+    reg[i] = 0, sig[i] = 0;
+  }
+  nt[2 * i] = sn > 0 ? sx / sn : 0;
+  nt[2 * i + 1] = sn > 0 ? sy / sn : 0;
 }
 
 void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
@@ -745,107 +750,109 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   real RHOD_LANES(scont);                  /* continuity, Eq. 22 */
   real RHOD_LANES(svsx), RHOD_LANES(svsy); /* F^mu */
   real RHOD_LANES(sddu), RHOD_LANES(sdrdu), RHOD_LANES(sruux), RHOD_LANES(sruuy); /* Eq. 4 */
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv){RHOD_FOR_LANES(k0, kv, k){PAIR_OR_SKIP(k);
-  const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k]; /* |grad_i W_ij| V_j */
-  const real fx = F * nx, fy = F * ny;
-  const real Pj = kP[k], uxj = kux[k], uyj = kuy[k];
-  real aR = renP * Pj, aC = (1 - renP) * Pj - kAD * kD[k];
-  RHOD_LANE(ssfx) += fx, RHOD_LANE(ssfy) += fy;
-  const real uni = uxi * nx + uyi * ny, unj = uxj * nx + uyj * ny;
-  if (riemann) {
-    /* weights of Eq. 12: w_i = dx_i / (dx_i + dx_j) (1/2 at equal sizes) */
-    const real dxj = kdx[k];
-    const real wi = dxj == dxi ? (real)0.5 : dxi / (dxi + dxj), wj = 1 - wi;
-    /* states of Eqs. 13-16 for P and the normal velocity u.n_ij */
-    real PL = Pi, PR = Pj, uL = uni, uR = unj;
-    if (recon) {
-      const real gPi_n = gPix * nx + gPiy * ny;
-      const real gPj_n = kgPx[k] * nx + kgPy[k] * ny;
-      const real gui_n = nx * (Gi0 * nx + Gi1 * ny) + ny * (Gi2 * nx + Gi3 * ny);
-      const real guj_n = nx * (kg0[k] * nx + kg1[k] * ny) + ny * (kg2[k] * nx + kg3[k] * ny);
-      const real sP = (Pj - Pi) * ir, su = (unj - uni) * ir;
-      PL = rhod_state(Pi, sP, gPi_n, wi * r), PR = rhod_state(Pj, sP, gPj_n, -wj * r);
-      uL = rhod_state(uni, su, gui_n, wi * r), uR = rhod_state(unj, su, guj_n, -wj * r);
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+    RHOD_FOR_LANES(k0, kv, k) {
+      PAIR_OR_SKIP(k);
+      const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k]; /* |grad_i W_ij| V_j */
+      const real fx = F * nx, fy = F * ny;
+      const real Pj = kP[k], uxj = kux[k], uyj = kuy[k];
+      real aR = renP * Pj, aC = (1 - renP) * Pj - kAD * kD[k];
+      RHOD_LANE(ssfx) += fx, RHOD_LANE(ssfy) += fy;
+      const real uni = uxi * nx + uyi * ny, unj = uxj * nx + uyj * ny;
+      if (riemann) {
+        /* weights of Eq. 12: w_i = dx_i / (dx_i + dx_j) (1/2 at equal sizes) */
+        const real dxj = kdx[k];
+        const real wi = dxj == dxi ? (real)0.5 : dxi / (dxi + dxj), wj = 1 - wi;
+        /* states of Eqs. 13-16 for P and the normal velocity u.n_ij */
+        real PL = Pi, PR = Pj, uL = uni, uR = unj;
+        if (recon) {
+          const real gPi_n = gPix * nx + gPiy * ny;
+          const real gPj_n = kgPx[k] * nx + kgPy[k] * ny;
+          const real gui_n = nx * (Gi0 * nx + Gi1 * ny) + ny * (Gi2 * nx + Gi3 * ny);
+          const real guj_n = nx * (kg0[k] * nx + kg1[k] * ny) + ny * (kg2[k] * nx + kg3[k] * ny);
+          const real sP = (Pj - Pi) * ir, su = (unj - uni) * ir;
+          PL = rhod_state(Pi, sP, gPi_n, wi * r), PR = rhod_state(Pj, sP, gPj_n, -wj * r);
+          uL = rhod_state(uni, su, gui_n, wi * r), uR = rhod_state(unj, su, guj_n, -wj * r);
+        }
+        const real rhoL = rho0 + PL * ic2, rhoR = rho0 + PR * ic2;
+        const real uE = rhod_pvrs_u(rhoL, rhoR, uL, uR, PL, PR, c0);
+        /* Eq. 22: -rho_i <div u> + Theta^rho = -2 rho_i sum (u_E + R_ij).n F V,
+         * R_ij = -(3/2 - w_i) u_i - (1/2 - w_j) u_j */
+        RHOD_LANE(scont) += (uE - ((real)1.5 - wi) * uni - ((real)0.5 - wj) * unj) * F;
+        if (!visc) {
+          /* Eq. 24: theta_ij = 2 (P_E - [(1 - w_i) P_i + (1 - w_j) P_j]) */
+          const real PE = rhod_pvrs_P(rhoL, rhoR, uL, uR, PL, PR, c0);
+          const real th = 2 * (PE - ((1 - wi) * Pi + (1 - wj) * Pj));
+          aR += tR * th;
+          aC += tC * th;
+        }
+      } else {
+        RHOD_LANE(scont) += (unj - uni) * F; /* Eq. 5 */
+      }
+      RHOD_LANE(svRx) += aR * fx, RHOD_LANE(svRy) += aR * fy;
+      RHOD_LANE(svCx) += aC * fx, RHOD_LANE(svCy) += aC * fy;
+      if (visc) {
+        /* consistent: mu 2 F (n.B^.n) ((u_j - u_i)/r - n.grad u_i), see pass A; Eq. 10:
+         * 2 (d + 2) mu pi_ij grad_i W_ij V_j */
+        const real fc = 2 * F * (bxx * nx * nx + 2 * bxy * nx * ny + byy * ny * ny);
+        const real pij = e10 * ((uxj - uxi) * rx + (uyj - uyi) * ry) * ir * ir;
+        RHOD_LANE(svsx) += fc * ((uxj - uxi) * ir - (Gi0 * nx + Gi1 * ny)) + pij * fx;
+        RHOD_LANE(svsy) += fc * ((uyj - uyi) * ir - (Gi2 * nx + Gi3 * ny)) + pij * fy;
+      }
+      if (shifting) {
+        const real duj = kdux[k], dvj = kduy[k], rhoj = krho[k];
+        const real dun_i = dui * nx + dvi * ny, dun_j = duj * nx + dvj * ny;
+        RHOD_LANE(sddu) += (dun_j - dun_i) * F;
+        RHOD_LANE(sdrdu) += (rhoi * dun_i + rhoj * dun_j) * F;
+        RHOD_LANE(sruux) += (rhoi * uxi * dun_i + rhoj * uxj * dun_j) * F;
+        RHOD_LANE(sruuy) += (rhoi * uyi * dun_i + rhoj * uyj * dun_j) * F;
+      }
     }
-    const real rhoL = rho0 + PL * ic2, rhoR = rho0 + PR * ic2;
-    const real uE = rhod_pvrs_u(rhoL, rhoR, uL, uR, PL, PR, c0);
-    /* Eq. 22: -rho_i <div u> + Theta^rho = -2 rho_i sum (u_E + R_ij).n F V,
-     * R_ij = -(3/2 - w_i) u_i - (1/2 - w_j) u_j */
-    RHOD_LANE(scont) += (uE - ((real)1.5 - wi) * uni - ((real)0.5 - wj) * unj) * F;
-    if (!visc) {
-      /* Eq. 24: theta_ij = 2 (P_E - [(1 - w_i) P_i + (1 - w_j) P_j]) */
-      const real PE = rhod_pvrs_P(rhoL, rhoR, uL, uR, PL, PR, c0);
-      const real th = 2 * (PE - ((1 - wi) * Pi + (1 - wj) * Pj));
-      aR += tR * th;
-      aC += tC * th;
-    }
-  } else {
-    RHOD_LANE(scont) += (unj - uni) * F; /* Eq. 5 */
+    RHOD_END_LANES
   }
-  RHOD_LANE(svRx) += aR * fx, RHOD_LANE(svRy) += aR * fy;
-  RHOD_LANE(svCx) += aC * fx, RHOD_LANE(svCy) += aC * fy;
-  if (visc) {
-    /* consistent: mu 2 F (n.B^.n) ((u_j - u_i)/r - n.grad u_i), see pass A; Eq. 10:
-     * 2 (d + 2) mu pi_ij grad_i W_ij V_j */
-    const real fc = 2 * F * (bxx * nx * nx + 2 * bxy * nx * ny + byy * ny * ny);
-    const real pij = e10 * ((uxj - uxi) * rx + (uyj - uyi) * ry) * ir * ir;
-    RHOD_LANE(svsx) += fc * ((uxj - uxi) * ir - (Gi0 * nx + Gi1 * ny)) + pij * fx;
-    RHOD_LANE(svsy) += fc * ((uyj - uyi) * ir - (Gi2 * nx + Gi3 * ny)) + pij * fy;
-  }
+  RHOD_END_ROWS
+  const real vRx = RHOD_LANES_SUM(svRx), vRy = RHOD_LANES_SUM(svRy);
+  const real vCx = RHOD_LANES_SUM(svCx), vCy = RHOD_LANES_SUM(svCy);
+  const real sfx = RHOD_LANES_SUM(ssfx), sfy = RHOD_LANES_SUM(ssfy);
+  const real cont = RHOD_LANES_SUM(scont), vsx = RHOD_LANES_SUM(svsx), vsy = RHOD_LANES_SUM(svsy);
+  const real ddu = RHOD_LANES_SUM(sddu), drdu = RHOD_LANES_SUM(sdrdu);
+  const real ruux = RHOD_LANES_SUM(sruux), ruuy = RHOD_LANES_SUM(sruuy);
+  const real *Li = L + 4 * i;
+  /* renormalised part: L^T (vR - renP P_i sf) */
+  const real wx = vRx - renP * Pi * sfx, wy = vRy - renP * Pi * sfy;
+  /* plain part: vC + ((1 - renP) P_i - kAD D_i) sf, i.e. sum (P_j + P_i) gW V for a
+   * conservative Eq. 6, and -F^AD of Eq. 9. With scheme.tensile_control, where
+   * P_i < 0 the conservative sum is sum (P_j - P_i) gW V instead: the tensile-
+   * instability switch of Sun et al. 2018 as paper 001 writes it (Eq. 5; paper 000
+   * Eq. 2, p_j +- p_i). Our choice (docs/choices.md): only where Eq. 6 is conservative
+   * (the renormalised bulk form avoids the tensile instability, paper 002 Sec. IV,
+   * item iv) and i is not itself a free-surface particle: with a truncated support the
+   * minus form loses the dynamic free-surface condition (paper 000 Sec. 2.1 asks for a
+   * free-surface detection to exclude it; applied on F too, the dam break at H/dx = 50
+   * blew up within 93 steps). */
+  const real Pc = ((K.flags & PC_TIC) && Pi < 0 && reg[i] != 2) ? -Pi : Pi;
+  const real ki = (1 - renP) * Pc - kAD * Di;
+  real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * K.gx + vsx;
+  real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * K.gy + vsy;
+  /* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
+  real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
   if (shifting) {
-    const real duj = kdux[k], dvj = kduy[k], rhoj = krho[k];
-    const real dun_i = dui * nx + dvi * ny, dun_j = duj * nx + dvj * ny;
-    RHOD_LANE(sddu) += (dun_j - dun_i) * F;
-    RHOD_LANE(sdrdu) += (rhoi * dun_i + rhoj * dun_j) * F;
-    RHOD_LANE(sruux) += (rhoi * uxi * dun_i + rhoj * uxj * dun_j) * F;
-    RHOD_LANE(sruuy) += (rhoi * uyi * dun_i + rhoj * uyj * dun_j) * F;
+    /* Eq. 4: -rho_i <div du> + <div(rho du)> and <div(rho u (x) du)>, sum forms
+     * sum (phi_i + phi_j) grad_i W_ij V_j. With scheme.shifting_switch, where Eq. 6 is
+     * renormalised (the support is full), the difference forms sum (phi_j - phi_i)
+     * grad_i W_ij V_j instead: the sum form carries 2 phi_i sum grad_i W_ij V_j =
+     * 2 phi_i grad Gamma_i, a zeroth-order error wherever grad Gamma_i != 0 inside the
+     * fluid, as at the size jumps of APR (our choice, docs/choices.md "Shifting terms at
+     * size jumps"). The free-surface region keeps the sum forms, as Eq. 6 keeps its
+     * conservative form there. sf = sum grad_i W_ij V_j, so the switch costs nothing in
+     * the loop. */
+    const real dsf = ((K.flags & PC_SHSW) ? renP : 0) * 2 * (dui * sfx + dvi * sfy);
+    dr += -rhoi * ddu + drdu - rhoi * dsf;
+    fx += ruux - rhoi * uxi * dsf, fy += ruuy - rhoi * uyi * dsf;
   }
-}
-RHOD_END_LANES
-}
-RHOD_END_ROWS
-const real vRx = RHOD_LANES_SUM(svRx), vRy = RHOD_LANES_SUM(svRy);
-const real vCx = RHOD_LANES_SUM(svCx), vCy = RHOD_LANES_SUM(svCy);
-const real sfx = RHOD_LANES_SUM(ssfx), sfy = RHOD_LANES_SUM(ssfy);
-const real cont = RHOD_LANES_SUM(scont), vsx = RHOD_LANES_SUM(svsx), vsy = RHOD_LANES_SUM(svsy);
-const real ddu = RHOD_LANES_SUM(sddu), drdu = RHOD_LANES_SUM(sdrdu);
-const real ruux = RHOD_LANES_SUM(sruux), ruuy = RHOD_LANES_SUM(sruuy);
-const real *Li = L + 4 * i;
-/* renormalised part: L^T (vR - renP P_i sf) */
-const real wx = vRx - renP * Pi * sfx, wy = vRy - renP * Pi * sfy;
-/* plain part: vC + ((1 - renP) P_i - kAD D_i) sf, i.e. sum (P_j + P_i) gW V for a
- * conservative Eq. 6, and -F^AD of Eq. 9. With scheme.tensile_control, where
- * P_i < 0 the conservative sum is sum (P_j - P_i) gW V instead: the tensile-
- * instability switch of Sun et al. 2018 as paper 001 writes it (Eq. 5; paper 000
- * Eq. 2, p_j +- p_i). Our choice (docs/choices.md): only where Eq. 6 is conservative
- * (the renormalised bulk form avoids the tensile instability, paper 002 Sec. IV,
- * item iv) and i is not itself a free-surface particle: with a truncated support the
- * minus form loses the dynamic free-surface condition (paper 000 Sec. 2.1 asks for a
- * free-surface detection to exclude it; applied on F too, the dam break at H/dx = 50
- * blew up within 93 steps). */
-const real Pc = ((K.flags & PC_TIC) && Pi < 0 && reg[i] != 2) ? -Pi : Pi;
-const real ki = (1 - renP) * Pc - kAD * Di;
-real fx = -(Li[0] * wx + Li[2] * wy) - (vCx + ki * sfx) + rhoi * K.gx + vsx;
-real fy = -(Li[1] * wx + Li[3] * wy) - (vCy + ki * sfy) + rhoi * K.gy + vsy;
-/* continuity: Eq. 22 with Riemann, else -rho_i <div u> (Eq. 5) */
-real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
-if (shifting) {
-  /* Eq. 4: -rho_i <div du> + <div(rho du)> and <div(rho u (x) du)>, sum forms
-   * sum (phi_i + phi_j) grad_i W_ij V_j. With scheme.shifting_switch, where Eq. 6 is
-   * renormalised (the support is full), the difference forms sum (phi_j - phi_i)
-   * grad_i W_ij V_j instead: the sum form carries 2 phi_i sum grad_i W_ij V_j =
-   * 2 phi_i grad Gamma_i, a zeroth-order error wherever grad Gamma_i != 0 inside the
-   * fluid, as at the size jumps of APR (our choice, docs/choices.md "Shifting terms at
-   * size jumps"). The free-surface region keeps the sum forms, as Eq. 6 keeps its
-   * conservative form there. sf = sum grad_i W_ij V_j, so the switch costs nothing in
-   * the loop. */
-  const real dsf = ((K.flags & PC_SHSW) ? renP : 0) * 2 * (dui * sfx + dvi * sfy);
-  dr += -rhoi * ddu + drdu - rhoi * dsf;
-  fx += ruux - rhoi * uxi * dsf, fy += ruuy - rhoi * uyi * dsf;
-}
-drho[i] = dr;
-acc[2 * i] = fx / rhoi, acc[2 * i + 1] = fy / rhoi;
-vel[2 * i] = uxi + dui, vel[2 * i + 1] = uyi + dvi;
+  drho[i] = dr;
+  acc[2 * i] = fx / rhoi, acc[2 * i + 1] = fy / rhoi;
+  vel[2 * i] = uxi + dui, vel[2 * i + 1] = uyi + dvi;
 }
 
 /* the specialised copies: Wendland C2 (the default kernel) with every combination of
@@ -1038,68 +1045,73 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     const real iR = 1 / Ri, iR3 = iR * iR * iR, vxi = v[2 * i], vyi = v[2 * i + 1];
     real RHOD_LANES(sB0), RHOD_LANES(sB1), RHOD_LANES(sB2), RHOD_LANES(sB3);
     real RHOD_LANES(sG0), RHOD_LANES(sG1), RHOD_LANES(sG2), RHOD_LANES(sG3);
-    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv){RHOD_FOR_LANES(k0, kv, k){PAIR_OR_SKIP(k);
-    const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
-    const real gwx = F * nx, gwy = F * ny, dvx = kvx[k] - vxi, dvy = kvy[k] - vyi;
-    RHOD_LANE(sB0) += rx * gwx, RHOD_LANE(sB1) += rx * gwy;
-    RHOD_LANE(sB2) += ry * gwx, RHOD_LANE(sB3) += ry * gwy;
-    RHOD_LANE(sG0) += dvx * gwx, RHOD_LANE(sG1) += dvx * gwy;
-    RHOD_LANE(sG2) += dvy * gwx, RHOD_LANE(sG3) += dvy * gwy;
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+      RHOD_FOR_LANES(k0, kv, k) {
+        PAIR_OR_SKIP(k);
+        const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k];
+        const real gwx = F * nx, gwy = F * ny, dvx = kvx[k] - vxi, dvy = kvy[k] - vyi;
+        RHOD_LANE(sB0) += rx * gwx, RHOD_LANE(sB1) += rx * gwy;
+        RHOD_LANE(sB2) += ry * gwx, RHOD_LANE(sB3) += ry * gwy;
+        RHOD_LANE(sG0) += dvx * gwx, RHOD_LANE(sG1) += dvx * gwy;
+        RHOD_LANE(sG2) += dvy * gwx, RHOD_LANE(sG3) += dvy * gwy;
+      }
+      RHOD_END_LANES
+    }
+    RHOD_END_ROWS
+    const real B0 = RHOD_LANES_SUM(sB0), B1 = RHOD_LANES_SUM(sB1), B2 = RHOD_LANES_SUM(sB2),
+               B3 = RHOD_LANES_SUM(sB3);
+    const real G0 = RHOD_LANES_SUM(sG0), G1 = RHOD_LANES_SUM(sG1), G2 = RHOD_LANES_SUM(sG2),
+               G3 = RHOD_LANES_SUM(sG3);
+    aD[i] = G0 + G3;
+    const real det = B0 * B3 - B1 * B2;
+    real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
+    if (det > (real)1e-2) {
+      const real id_ = 1 / det;
+      L0 = B3 * id_, L1 = -B1 * id_, L2 = -B2 * id_, L3 = B0 * id_;
+    }
+    aG[4 * i] = L0 * G0 + L2 * G1, aG[4 * i + 1] = L1 * G0 + L3 * G1;
+    aG[4 * i + 2] = L0 * G2 + L2 * G3, aG[4 * i + 3] = L1 * G2 + L3 * G3;
   }
-  RHOD_END_LANES
-}
-RHOD_END_ROWS
-const real B0 = RHOD_LANES_SUM(sB0), B1 = RHOD_LANES_SUM(sB1), B2 = RHOD_LANES_SUM(sB2),
-           B3 = RHOD_LANES_SUM(sB3);
-const real G0 = RHOD_LANES_SUM(sG0), G1 = RHOD_LANES_SUM(sG1), G2 = RHOD_LANES_SUM(sG2),
-           G3 = RHOD_LANES_SUM(sG3);
-aD[i] = G0 + G3;
-const real det = B0 * B3 - B1 * B2;
-real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
-if (det > (real)1e-2) {
-  const real id_ = 1 / det;
-  L0 = B3 * id_, L1 = -B1 * id_, L2 = -B2 * id_, L3 = B0 * id_;
-}
-aG[4 * i] = L0 * G0 + L2 * G1, aG[4 * i + 1] = L1 * G0 + L3 * G1;
-aG[4 * i + 2] = L0 * G2 + L2 * G3, aG[4 * i + 3] = L1 * G2 + L3 * G3;
-}
-/* the ghosts' D (ghost_div, as rhod_sph_mirror_gradients), and the second gather's row */
-RHOD_KERNEL_LOOP
-for (long g = n; g < nt; g++) {
-  const int k = gsrc[g];
-  aD[g] = ghost_div(gJ + 4 * g, gT + 4 * g, aG + 4 * k, aD[k]);
-}
-RHOD_KERNEL_LOOP
-for (long k = 0; k < nt; k++)
-  pk[PK_D * st + k] = aD[CI[k]];
-/* F^AD / rho of the iterate (Eq. 9, h_i = R_i / 2 as in pass C), which becomes the next
- * iterate; |A v| / |v| estimates the largest |lambda|. The norms are summed in loops
- * of their own, so that the gather needs no reduction (RHOD_GATHER_LOOP) */
-real nw = 0, n0 = 0;
-RHOD_KERNEL_LOOP_REDUCE(+, n0)
-for (long i = 0; i < n; i++)
-  n0 += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
-RHOD_GATHER_LOOP
-for (long i = 0; i < n; i++) {
-  const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st, *kD = pk + PK_D * st;
-  const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri, Di = aD[i];
-  const real iR = 1 / Ri, iR3 = iR * iR * iR;
-  real RHOD_LANES(sfx), RHOD_LANES(sfy);
-  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv){RHOD_FOR_LANES(k0, kv, k){PAIR_OR_SKIP(k);
-  const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k] * (kD[k] + Di);
-  RHOD_LANE(sfx) += F * nx, RHOD_LANE(sfy) += F * ny;
-}
-RHOD_END_LANES
-}
-RHOD_END_ROWS
-const real fx = RHOD_LANES_SUM(sfx), fy = RHOD_LANES_SUM(sfy);
-const real ki = kad * Ri / rho[i];
-v[2 * i] = ki * fx, v[2 * i + 1] = ki * fy;
-}
-RHOD_KERNEL_LOOP_REDUCE(+, nw)
-for (long i = 0; i < n; i++)
-  nw += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
-return n0 > 0 ? sqrt(nw / n0) : 0;
+  /* the ghosts' D (ghost_div, as rhod_sph_mirror_gradients), and the second gather's row */
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++) {
+    const int k = gsrc[g];
+    aD[g] = ghost_div(gJ + 4 * g, gT + 4 * g, aG + 4 * k, aD[k]);
+  }
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt; k++)
+    pk[PK_D * st + k] = aD[CI[k]];
+  /* F^AD / rho of the iterate (Eq. 9, h_i = R_i / 2 as in pass C), which becomes the next
+   * iterate; |A v| / |v| estimates the largest |lambda|. The norms are summed in loops
+   * of their own, so that the gather needs no reduction (RHOD_GATHER_LOOP) */
+  real nw = 0, n0 = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, n0)
+  for (long i = 0; i < n; i++)
+    n0 += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
+  RHOD_GATHER_LOOP
+  for (long i = 0; i < n; i++) {
+    const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st,
+               *kD = pk + PK_D * st;
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri, Di = aD[i];
+    const real iR = 1 / Ri, iR3 = iR * iR * iR;
+    real RHOD_LANES(sfx), RHOD_LANES(sfy);
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+      RHOD_FOR_LANES(k0, kv, k) {
+        PAIR_OR_SKIP(k);
+        const real F = -rhod_dWq(kern, r * iR) * iR3 * kV[k] * (kD[k] + Di);
+        RHOD_LANE(sfx) += F * nx, RHOD_LANE(sfy) += F * ny;
+      }
+      RHOD_END_LANES
+    }
+    RHOD_END_ROWS
+    const real fx = RHOD_LANES_SUM(sfx), fy = RHOD_LANES_SUM(sfy);
+    const real ki = kad * Ri / rho[i];
+    v[2 * i] = ki * fx, v[2 * i + 1] = ki * fy;
+  }
+  RHOD_KERNEL_LOOP_REDUCE(+, nw)
+  for (long i = 0; i < n; i++)
+    nw += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
+  return n0 > 0 ? sqrt(nw / n0) : 0;
 }
 
 real rhod_sph_dt(rhod_sph *s, const rhod_particles *p) {

@@ -98,8 +98,8 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
  * tests the distance against it. */
 #define RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j)                                              \
   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0_, k1_, kv_)                                                  \
-  for (int k_ = k0_; k_ < k1_; k_++) {                                                             \
-    const int j = (CI)[k_];
+    for (int k_ = k0_; k_ < k1_; k_++) {                                                           \
+      const int j = (CI)[k_];
 #define RHOD_END_NEIGHBOURS                                                                        \
   }                                                                                                \
   RHOD_END_ROWS
