@@ -103,7 +103,7 @@ int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], doubl
   c->ncells_box = c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   map_alloc(&c->start, c->ncells_box + 1);
   map_alloc(&c->count, c->ncells_box + 1);
-  c->mark = rhod_dev_calloc(c->ncells_box, 1);
+  c->mark = rhod_dev_calloc(c->ncells_box, sizeof(int32_t));
   if (!c->start || !c->count || !c->mark)
     return RHOD_ERR_MEMORY;
   return rhod_cells_reserve(c, cap);
@@ -123,7 +123,7 @@ int rhod_cells_reserve(rhod_cells *c, size_t cap) {
 void rhod_cells_free(rhod_cells *c) {
   map_free(&c->start, c->ncells_box + 1);
   map_free(&c->count, c->ncells_box + 1);
-  rhod_dev_free(c->mark, c->ncells_box);
+  rhod_dev_free(c->mark, c->ncells_box * sizeof(int32_t));
   c->mark = NULL;
   map_free(&c->idx, c->cap);
   map_free(&c->key, c->cap);
@@ -208,13 +208,22 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
 
 void rhod_cells_mark(rhod_cells *c, const uint8_t *flag) {
   const int32_t *start = c->start, *idx = c->idx;
-  uint8_t *mark = c->mark;
-  const long nc = (long)c->ncells;
+  int32_t *mark = c->mark;
+  const long nc = (long)c->ncells, nx = c->g.nx, ny = c->g.ny;
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nc; k++) {
-    uint8_t m = 0;
+    int32_t m = 0;
     for (int s = start[k]; s < start[k + 1] && !m; s++)
       m = flag[idx[s]] != 0;
     mark[k] = m;
+  }
+  /* running counts along each row (one row per thread: rows are a few hundred cells) */
+  RHOD_KERNEL_LOOP
+  for (long r = 0; r < ny; r++) {
+    int32_t a = 0;
+    for (long k = r * nx; k < (r + 1) * nx; k++) {
+      a += mark[k];
+      mark[k] = a;
+    }
   }
 }

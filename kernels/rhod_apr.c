@@ -180,7 +180,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real *V = s->V, *P = s->P, *gP = s->gP;
   const real *seg = b->seg, *circ = b->circ;
   const int nseg = b->nseg, ncirc = b->ncirc;
-  const uint8_t *reg = s->reg, *fs = s->fs, *near = a->near, *near2 = a->near2, *cmark = c->mark;
+  const uint8_t *reg = s->reg, *fs = s->fs, *near = a->near, *near2 = a->near2;
+  const int32_t *cmark = c->mark;
   const real *sig = s->sig;
   uint8_t *mark = a->mark;
   real *sd = a->sd, *sp = a->sp;

@@ -509,7 +509,7 @@ void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p) {
  * refinement.surface_band (rhod_apr_mark) reads d_i / R_i back as 1 - sigma_i: a change
  * of sigma's definition must change it too (test_apr's direct sum fails otherwise). */
 #define RG_PARAMS                                                                                  \
-  rhod_grid G, const int32_t *CS, const uint8_t *mark, const real *x, const real *y,               \
+  rhod_grid G, const int32_t *CS, const int32_t *mark, const real *x, const real *y,               \
       const real *dx, const uint8_t *fs, const real *pk, long st, uint8_t *reg, real *nt,          \
       real *sig, const real ratio
 #define RG_ARGS G, CS, mark, x, y, dx, fs, pk, st, reg, nt, sig, ratio
@@ -578,7 +578,7 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   const long nt_ = (long)(p->n + p->ng), st = (long)p->cap;
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
-  const uint8_t *mark = c->mark;
+  const int32_t *mark = c->mark;
   real *pk = s->pk;
   /* the flags and normals in the cells' order, next to pass A's packed positions */
   RHOD_KERNEL_LOOP

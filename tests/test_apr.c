@@ -103,6 +103,33 @@ static long gather_mismatches(const rhod_particles *p, rhod_grid G, const int32_
   return bad;
 }
 
+/* rhod_cells_near_mark against brute force: for every particle i (R_i = 4 dx_i), whether
+ * some flagged particle lies in a cell within reach of i's cell (the cells of the
+ * scan). Returns the particles where the two differ; counts those near a mark. */
+static long near_mark_mismatches(const rhod_particles *p, rhod_cells *c, const uint8_t *flag,
+                                 long *near) {
+  rhod_cells_mark(c, flag);
+  rhod_to_host(c->mark, c->ncells * sizeof(int32_t));
+  const rhod_grid G = c->g;
+  const long n = (long)p->n;
+  long bad = 0;
+  *near = 0;
+  for (long i = 0; i < n; i++) {
+    const real Ri = 4 * p->dx[i];
+    const int rc = rhod_cell_reach(G, Ri);
+    const int cx = rhod_cell_coord(p->x[i], G.ox, G.inv, G.cx0, G.nx);
+    const int cy = rhod_cell_coord(p->y[i], G.oy, G.inv, G.cy0, G.ny);
+    int want = 0;
+    for (long j = 0; j < n && !want; j++)
+      want = flag[j] && abs(rhod_cell_coord(p->x[j], G.ox, G.inv, G.cx0, G.nx) - cx) <= rc &&
+             abs(rhod_cell_coord(p->y[j], G.oy, G.inv, G.cy0, G.ny) - cy) <= rc;
+    const int got = rhod_cells_near_mark(G, c->mark, p->x[i], p->y[i], Ri);
+    *near += got;
+    bad += got != want;
+  }
+  return bad;
+}
+
 static void test_mixed_size_neighbours(void) {
   const double dx = 0.01;
   rhod_particles p;
@@ -122,7 +149,12 @@ static void test_mixed_size_neighbours(void) {
                               {3 * dx, 3 * dx, 53 * dx, 29 * dx},
                               {20 * dx, 3 * dx, 30 * dx, 29 * dx}};
   const double radii[2] = {4 * dx, 16 * dx}; /* grid for the finest, for the coarsest radius */
-  long padded_all = 0;
+  long padded_all = 0, far_all = 0;
+  uint8_t *flag = rhod_dev_calloc(p.cap, 1);
+  CU_ASSERT_PTR_NOT_NULL_FATAL(flag);
+  for (size_t i = 0; i < p.n; i++) /* a few, in the lower left corner */
+    flag[i] = p.x[i] < 5 * dx && p.y[i] < 5 * dx && i % 3 == 0;
+  rhod_to_device(flag, p.cap);
   for (int b = 0; b < 3; b++)
     for (int r = 0; r < 2; r++)
       for (int reach = 1; reach <= 3; reach++) {
@@ -142,6 +174,15 @@ static void test_mixed_size_neighbours(void) {
         CU_ASSERT_EQUAL(dups, 0);
         CU_ASSERT(pairs > 40 * (long)p.n); /* about 50 each, fewer at the edges */
         CU_ASSERT(mixed > 2000);           /* the size interfaces are in the test */
+        /* the per-cell marks: a sparse set of flagged particles */
+        long near;
+        const long mbad = near_mark_mismatches(&p, &c, flag, &near);
+        if (mbad)
+          fprintf(stderr, "\nbox %d radius %g reach %d: %ld particles with a wrong mark\n", b,
+                  radii[r], reach, mbad);
+        CU_ASSERT_EQUAL(mbad, 0);
+        CU_ASSERT(near > 0);
+        far_all += (long)p.n - near;
         if (r == 0) {
           /* the wider scan of coarse particles matters here: the plain scan of a
            * grid for the finest radius (every particle scanning `reach` cells)
@@ -156,6 +197,8 @@ static void test_mixed_size_neighbours(void) {
       }
   /* the padding was exercised where the gathers vectorise (none elsewhere) */
   CU_ASSERT(RHOD_VLANES > 1 ? padded_all > 0 : padded_all == 0);
+  CU_ASSERT(far_all > 1000); /* and particles with no mark in reach */
+  rhod_dev_free(flag, p.cap);
   rhod_particles_free(&p);
 }
 

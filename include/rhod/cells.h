@@ -46,7 +46,7 @@ typedef struct {
   int32_t *count;     /* ncells: histogram scratch */
   int32_t *idx;       /* cap: particle indices sorted by cell */
   int32_t *key;       /* cap: cell of each particle */
-  uint8_t *mark;      /* ncells: per-cell flag (rhod_cells_mark) */
+  int32_t *mark;      /* ncells: marked cells of the row up to this one (rhod_cells_mark) */
   size_t cap;
 } rhod_cells;
 
@@ -62,9 +62,10 @@ void rhod_cells_free(rhod_cells *c);
  * still scans every particle within reach of it. */
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count);
 
-/* mark[c] = 1 when some particle of cell c has flag != 0 (flags of the particles
- * sorted by the last build). Lets a gather skip particles with no flagged
- * particle in reach (rhod_cells_near_mark). */
+/* A cell is marked when some particle in it has flag != 0 (flags of the particles
+ * sorted by the last build); mark[c] counts the marked cells of c's row up to and
+ * including c, so that a range of a row is tested with two reads. Lets a gather skip
+ * particles with no flagged particle in reach (rhod_cells_near_mark). */
 void rhod_cells_mark(rhod_cells *c, const uint8_t *flag);
 
 /* Cell coordinate of a position along one axis in the window [off, off + n) of the
@@ -214,7 +215,7 @@ static inline real rhod_lanes_min_(const real *s) {
 
 /* 1 when a cell within reach of a support of radius R at (x, y) is marked (inside
  * device regions: pass a local copy of c->mark). */
-static inline int rhod_cells_near_mark_(const uint8_t *mark, real ox, real oy, real inv, int cx0,
+static inline int rhod_cells_near_mark_(const int32_t *mark, real ox, real oy, real inv, int cx0,
                                         int cy0, int nx, int ny, int rc, real x, real y) {
   const int cx = rhod_cell_coord(x, ox, inv, cx0, nx);
   const int cy = rhod_cell_coord(y, oy, inv, cy0, ny);
@@ -222,10 +223,11 @@ static inline int rhod_cells_near_mark_(const uint8_t *mark, real ox, real oy, r
   const int y1 = cy + rc < ny - 1 ? cy + rc : ny - 1;
   const int x0 = cx - rc > 0 ? cx - rc : 0;
   const int x1 = cx + rc < nx - 1 ? cx + rc : nx - 1;
-  for (int yy = y0; yy <= y1; yy++)
-    for (int xx = x0; xx <= x1; xx++)
-      if (mark[yy * nx + xx])
-        return 1;
+  for (int yy = y0; yy <= y1; yy++) {
+    const int32_t *row = mark + (long)yy * nx;
+    if (row[x1] - (x0 > 0 ? row[x0 - 1] : 0) > 0)
+      return 1;
+  }
   return 0;
 }
 /* (the grid's fields are passed one by one: GCC 12's nvptx offload compiler fails with
