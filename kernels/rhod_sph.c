@@ -235,7 +235,7 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   real RHOD_LANES(sg), RHOD_LANES(sggx), RHOD_LANES(sggy), RHOD_LANES(sB0), RHOD_LANES(sB1),
       RHOD_LANES(sB2), RHOD_LANES(sB3), RHOD_LANES(sGPx), RHOD_LANES(sGPy), RHOD_LANES(sGu0),
       RHOD_LANES(sGu1), RHOD_LANES(sGu2), RHOD_LANES(sGu3), RHOD_LANES(scx), RHOD_LANES(scy),
-      RHOD_LANES(sum);
+      RHOD_LANES(such);
   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
     RHOD_FOR_LANES(k0, kv, k) {
       PAIR_OR_SKIP(k);
@@ -258,7 +258,7 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
       const real f = 1 + (real)0.2 * wr * wr * wr * wr;
       RHOD_LANE(scx) += f * gwx, RHOD_LANE(scy) += f * gwy;
       const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
-      RHOD_LANE(sum) = un > RHOD_LANE(sum) ? un : RHOD_LANE(sum);
+      RHOD_LANE(such) = un > RHOD_LANE(such) ? un : RHOD_LANE(such);
     }
     RHOD_END_LANES
   }
@@ -270,7 +270,7 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   const real GPx = RHOD_LANES_SUM(sGPx), GPy = RHOD_LANES_SUM(sGPy);
   const real Gu0 = RHOD_LANES_SUM(sGu0), Gu1 = RHOD_LANES_SUM(sGu1), Gu2 = RHOD_LANES_SUM(sGu2),
              Gu3 = RHOD_LANES_SUM(sGu3);
-  const real cx = RHOD_LANES_SUM(scx), cy = RHOD_LANES_SUM(scy), um = RHOD_LANES_MAX(sum);
+  const real cx = RHOD_LANES_SUM(scx), cy = RHOD_LANES_SUM(scy), um = RHOD_LANES_MAX(such);
   const real div = Gu0 + Gu3; /* Eq. 5: sum (u_j - u_i) . grad_i W_ij V_j, the trace */
   gam[i] = g;
   ggam[2 * i] = ggx, ggam[2 * i + 1] = ggy;

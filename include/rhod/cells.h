@@ -144,10 +144,11 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
  * array of one partial sum per lane; the candidates of a row are taken a vector at a
  * time (an `omp simd` loop of RHOD_VLANES lanes, lane l adding to its own element), and
  * the lanes are added once, after the last row. An `omp simd reduction` over each row
- * instead adds its lanes at the end of every row: with AVX-512, 8 lanes times 17 sums
- * of pass A, five to 33 times per particle, which took half of pass A
- * (perf/RESULTS.md "Gather sums kept per lane"). A vector whose candidates are all
- * outside the support costs a distance test. Elsewhere (the device, whose lanes are
+ * instead adds its lanes at the end of every row, which GCC 12 does one element at a
+ * time: with AVX-512, 8 lanes times 17 sums of pass A, five to 33 times per particle.
+ * Kept per lane, the sums made pass A 1.5 to 3 times as fast (perf/RESULTS.md
+ * "Gather sums kept per lane"). A vector whose candidates are all outside the support
+ * costs a distance test. Elsewhere (the device, whose lanes are
  * particles, or a host without vectors) each sum is a plain scalar and the loop a
  * plain loop over [k0, kv):
  *
