@@ -209,20 +209,16 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
 void rhod_cells_mark(rhod_cells *c, const uint8_t *flag) {
   const int32_t *start = c->start, *idx = c->idx;
   int32_t *mark = c->mark;
-  const long nc = (long)c->ncells, nx = c->g.nx, ny = c->g.ny;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nc; k++) {
-    int32_t m = 0;
-    for (int s = start[k]; s < start[k + 1] && !m; s++)
-      m = flag[idx[s]] != 0;
-    mark[k] = m;
-  }
-  /* running counts along each row (one row per thread: rows are a few hundred cells) */
+  const long nx = c->g.nx, ny = c->g.ny;
+  /* one row per thread, the running count along it (rows are a few hundred cells) */
   RHOD_KERNEL_LOOP
   for (long r = 0; r < ny; r++) {
     int32_t a = 0;
     for (long k = r * nx; k < (r + 1) * nx; k++) {
-      a += mark[k];
+      int32_t m = 0;
+      for (int s = start[k]; s < start[k + 1] && !m; s++)
+        m = flag[idx[s]] != 0;
+      a += m;
       mark[k] = a;
     }
   }

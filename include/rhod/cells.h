@@ -148,9 +148,8 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
  * time: with AVX-512, 8 lanes times 17 sums of pass A, five to 33 times per particle.
  * Kept per lane, the sums made pass A 1.5 to 3 times as fast (perf/RESULTS.md
  * "Gather sums kept per lane"). A vector whose candidates are all outside the support
- * costs a distance test. Elsewhere (the device, whose lanes are
- * particles, or a host without vectors) each sum is a plain scalar and the loop a
- * plain loop over [k0, kv):
+ * costs a distance test. Elsewhere (the device, whose lanes are particles, or a host
+ * without vectors) each sum is a plain scalar and the loop a plain loop over [k0, kv):
  *
  *   real RHOD_LANES(s);                  (declared and set to 0; RHOD_LANES_SET(s, v) sets v)
  *   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
