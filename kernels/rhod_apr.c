@@ -116,40 +116,45 @@ static int ensure(rhod_apr *a, size_t n) {
              : RHOD_ERR_MEMORY;
 }
 
-/* The field of criterion 5 at particle j: P, or the dynamic pressure rho |u|^2 / 2. */
-static inline real field_at(int dyn, const real *rho, const real *ux, const real *uy, const real *P,
-                            long j) {
-  return dyn ? (real)0.5 * rho[j] * (ux[j] * ux[j] + uy[j] * uy[j]) : P[j];
+/* The field of criterion 5 of a particle: P, or the dynamic pressure rho |u|^2 / 2. */
+static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
+  return dyn ? (real)0.5 * rho * (ux * ux + uy * uy) : P;
 }
 
-/* Sums of the criteria over the neighbours j != i within R of particle i, added to
- * the variables named (which hold the self terms): Gamma_ij = W(r_ij; R) V_j over
- * sizes >= big into same (criterion 2), any size <= small into anysmall (criterion 1),
- * the Shepard sums of the criterion-5 field into num, den (with c5), and the nearest
- * neighbour into best (r^2, start it at R^2), ex, ey (x_j - x_i). One text for a
- * particle's own support and for the support 2 R_i of the particle its coalescing
- * group would make. A macro over the marking loop's locals (G, CS, CI, x, y, dx, V,
- * rho, ux, uy, P, kern, c5, dyn), not a function: GCC 12 nvptx puts a returned
- * struct, like pointer outputs, in the warp-shared frame (tests/offload_frames.sh). */
-#define CRITERIA_SUMS(i, R, small, big, same, num, den, best, ex, ey, anysmall)                    \
+/* Sums of the criteria over the neighbours j within R of particle i (r_ij > 0, which
+ * leaves i out), added to the variables named (which hold the self terms): Gamma_ij =
+ * W(r_ij; R) V_j over sizes >= big into same (criterion 2), any size <= small into
+ * anysmall (criterion 1), and the Shepard sums of the criterion-5 field into num, den
+ * (computed always, used only with c5: a branch would keep the loop from vectorising).
+ * One text for a particle's own support and for the support e R_i of the particle its
+ * coalescing group would make. Reads the rows the last right-hand side packed in cell
+ * order (RHOD_PK_*) in vector lanes (cells.h RHOD_FOR_LANES), as the scheme's gathers do.
+ * A macro over the marking loop's locals (G, CS, x, y, kx, ky, kV, kdx, kP, kux, kuy,
+ * krho, kern, dyn), not a function: GCC 12 nvptx puts a returned struct, like pointer
+ * outputs, in the warp-shared frame (tests/offload_frames.sh). */
+#define CRITERIA_SUMS(i, R, small, big, same, num, den, anysmall)                                  \
   {                                                                                                \
     const real xs_ = x[i], ys_ = y[i], R2_ = (R) * (R), iR_ = 1 / (R), iR2_ = iR_ * iR_;           \
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xs_, ys_, (R), j) {                                             \
-      const real rx_ = x[j] - xs_, ry_ = y[j] - ys_, r2_ = rx_ * rx_ + ry_ * ry_;                  \
-      if (r2_ < R2_ && j != (i)) {                                                                 \
-        if (r2_ < (best))                                                                          \
-          (best) = r2_, (ex) = rx_, (ey) = ry_;                                                    \
-        const real dxj_ = dx[j];                                                                   \
-        (anysmall) |= dxj_ <= (small);                                                             \
-        const real w_ = rhod_Wq(kern, sqrt(r2_) * iR_) * iR2_ * V[j];                              \
-        (same) += dxj_ >= (big) ? w_ : 0;                                                          \
-        if (c5) {                                                                                  \
-          const real phij_ = field_at(dyn, rho, ux, uy, P, j);                                     \
-          (num) += w_ * phij_, (den) += w_;                                                        \
-        }                                                                                          \
+    real RHOD_LANES(ssame_), RHOD_LANES(snum_), RHOD_LANES(sden_), RHOD_LANES(ssmall_);            \
+    RHOD_FOR_ROWS(G, CS, xs_, ys_, (R), k0_, k1_, kv_) {                                           \
+      RHOD_FOR_LANES(k0_, kv_, k_) {                                                               \
+        const real rx_ = kx[k_] - xs_, ry_ = ky[k_] - ys_, r2_ = rx_ * rx_ + ry_ * ry_;            \
+        if (!(r2_ < R2_ && r2_ > 0))                                                               \
+          continue;                                                                                \
+        const real dxj_ = kdx[k_];                                                                 \
+        RHOD_LANE(ssmall_) = dxj_ <= (small) ? 1 : RHOD_LANE(ssmall_);                             \
+        const real w_ = rhod_Wq(kern, sqrt(r2_) * iR_) * iR2_ * kV[k_];                            \
+        RHOD_LANE(ssame_) += dxj_ >= (big) ? w_ : 0;                                               \
+        const real phij_ = field_of(dyn, krho[k_], kux[k_], kuy[k_], kP[k_]);                      \
+        RHOD_LANE(snum_) += w_ * phij_, RHOD_LANE(sden_) += w_;                                    \
       }                                                                                            \
+      RHOD_END_LANES                                                                               \
     }                                                                                              \
-    RHOD_END_NEIGHBOURS                                                                            \
+    RHOD_END_ROWS                                                                                  \
+    const real same_ = RHOD_LANES_SUM(ssame_), num_ = RHOD_LANES_SUM(snum_);                       \
+    const real den_ = RHOD_LANES_SUM(sden_), small_ = RHOD_LANES_MAX(ssmall_);                     \
+    (same) += same_, (num) += num_, (den) += den_;                                                 \
+    (anysmall) |= small_ > 0;                                                                      \
   }
 
 /* Candidates not grouped go back to no mark. */
@@ -178,6 +183,12 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const int32_t *CS = c->start, *CI = c->idx;
   const real *x = p->x, *y = p->y, *dx = p->dx, *ux = p->ux, *uy = p->uy, *rho = p->rho;
   const real *V = s->V, *P = s->P, *gP = s->gP;
+  /* the neighbour side of the criteria's sums: the rows packed by the last right-hand side */
+  const long st = (long)p->cap;
+  const real *kx = s->pk + RHOD_PK_X * st, *ky = s->pk + RHOD_PK_Y * st;
+  const real *kV = s->pk + RHOD_PK_V * st, *kdx = s->pk + RHOD_PK_DX * st;
+  const real *kP = s->pk + RHOD_PK_P * st, *kux = s->pk + RHOD_PK_UX * st;
+  const real *kuy = s->pk + RHOD_PK_UY * st, *krho = s->pk + RHOD_PK_RHO * st;
   const real *seg = b->seg, *circ = b->circ;
   const int nseg = b->nseg, ncirc = b->ncirc;
   const uint8_t *reg = s->reg, *fs = s->fs, *near = a->near, *near2 = a->near2;
@@ -216,15 +227,14 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     const real iR = 1 / Ri, iR2 = iR * iR;
     const real self = rhod_Wq(kern, 0) * iR2 * V[i]; /* Gamma_ii, Eq. 7 */
-    const real phii = field_at(dyn, rho, ux, uy, P, i);
+    const real phii = field_of(dyn, rho[i], ux[i], uy[i], P[i]);
     /* criterion 1: a neighbour two levels finer, dx_i / e^2 (dx_i / 4 at e = 2) */
     const real quarter = dxi * ieps * ieps * (1 + SIZE_TOL), lower = dxi * (1 - SIZE_TOL);
-    real best = R2, ex = 1, ey = 0;
     real same = self; /* criterion 2: sum of Gamma_ij over dx_j >= dx_i, i included */
     real num = self * phii, den = self; /* criterion 5: Shepard average, i included */
     int grand = 0;                      /* criterion 1 */
     if (can_split) /* a particle at dx_min is here only as a coalescing candidate */
-      CRITERIA_SUMS(i, Ri, quarter, lower, same, num, den, best, ex, ey, grand);
+      CRITERIA_SUMS(i, Ri, quarter, lower, same, num, den, grand);
     const real phi = num / den;
     const int in3 = c3 && (reg[i] == 2 || (reg[i] == 1 && (band >= 1 || sig[i] > sband)));
     const int m = can_split && (grand || same < 2 * self || in3 || (c4 && near[i]) ||
@@ -253,17 +263,27 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
       if (ok) {
         const real self2 = rhod_Wq(kern, 0) * iRD2 * nsplit * V[i];
         const real half = ieps * dxi * (1 + SIZE_TOL), big = eps * dxi * (1 - SIZE_TOL);
-        real same2 = 0, num2 = self2 * phii, den2 = self2, best2 = RD * RD, ex2 = 1, ey2 = 0;
+        real same2 = 0, num2 = self2 * phii, den2 = self2;
         int fine = 0;
-        CRITERIA_SUMS(i, RD, half, big, same2, num2, den2, best2, ex2, ey2, fine);
-        (void)ex2, (void)ey2; /* the nearest neighbour is not needed here */
+        CRITERIA_SUMS(i, RD, half, big, same2, num2, den2, fine);
         const real phi2 = num2 / den2;
         ok = !fine && !(c5 && (phi2 > above2 || phi2 < below2));
         sp[i] = same2;
       }
       mark[i] = ok ? 2 : 0;
     }
-    if (!m || !(best < R2))
+    if (!m)
+      continue;
+    /* the nearest neighbour, for the marked particles only: the first of the nearest in
+     * the cells' order */
+    real best = R2, ex = 1, ey = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
+      if (r2 < best && j != i)
+        best = r2, ex = rx, ey = ry;
+    }
+    RHOD_END_NEIGHBOURS
+    if (!(best < R2))
       continue;
     /* Pattern of the children (Sec. V A, Fig. 5). The paper turns the square of side
      * dx_i/2 towards the nearest neighbour "to maximize the minimum inter-particle

@@ -30,38 +30,6 @@
   const real r = sqrt(r2), ir = 1 / r;                                                             \
   const real nx = rx * ir, ny = ry * ir
 
-/* Rows of s->pk: the neighbour-side fields of the gathers, copied into the order of
- * the sorted cells (row r of particle CI[k] at pk[r * cap + k]), so that the inner
- * loops over a row of cells read them contiguously and vectorise (RHOD_FOR_ROWS).
- * Pass A packs the first rows (the state), pass C the rest (pass A's gradients, the
- * shifting velocity and rho). The cells must have been built over the fluid and the
- * ghosts. */
-enum {
-  PK_X,
-  PK_Y,
-  PK_V,
-  PK_P,
-  PK_UX,
-  PK_UY,
-  PK_DX, /* the rows above: pass A's */
-  PK_D,
-  PK_GPX,
-  PK_GPY,
-  PK_GU0,
-  PK_GU1,
-  PK_GU2,
-  PK_GU3,
-  PK_DUX,
-  PK_DUY,
-  PK_RHO, /* from PK_D: pass C's */
-  PK_ROWS,
-  /* the region pass's rows, in pass C's (packed again by pass C after it): the
-   * free-surface flag (0 or 1) and normal */
-  PK_FS = PK_D,
-  PK_NX = PK_GPX,
-  PK_NY = PK_GPY
-};
-
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   memset(s, 0, sizeof *s);
   s->kernel = sc->kernel;
@@ -117,7 +85,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   F(reg, 1);
   if (s->visc_cons) /* a scene without it does not carry it */
     F(lapB, 3);
-  F(pk, PK_ROWS);
+  F(pk, RHOD_PK_ROWS);
   if (s->adlim) {
     st = st == RHOD_OK ? rhod_particles_add_field(p, "adv", (void **)&s->adv, 2 * sizeof *s->adv, 1)
                        : st;
@@ -171,9 +139,9 @@ static void pack_a(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nt; k++) {
     const int j = CI[k];
-    pk[PK_X * st + k] = x[j], pk[PK_Y * st + k] = y[j], pk[PK_V * st + k] = V[j];
-    pk[PK_P * st + k] = P[j], pk[PK_UX * st + k] = ux[j], pk[PK_UY * st + k] = uy[j];
-    pk[PK_DX * st + k] = dx[j];
+    pk[RHOD_PK_X * st + k] = x[j], pk[RHOD_PK_Y * st + k] = y[j], pk[RHOD_PK_V * st + k] = V[j];
+    pk[RHOD_PK_P * st + k] = P[j], pk[RHOD_PK_UX * st + k] = ux[j], pk[RHOD_PK_UY * st + k] = uy[j];
+    pk[RHOD_PK_DX * st + k] = dx[j];
   }
 }
 
@@ -185,12 +153,12 @@ static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nt; k++) {
     const int j = CI[k];
-    pk[PK_D * st + k] = D[j];
-    pk[PK_GPX * st + k] = gP[2 * j], pk[PK_GPY * st + k] = gP[2 * j + 1];
-    pk[PK_GU0 * st + k] = gu[4 * j], pk[PK_GU1 * st + k] = gu[4 * j + 1];
-    pk[PK_GU2 * st + k] = gu[4 * j + 2], pk[PK_GU3 * st + k] = gu[4 * j + 3];
-    pk[PK_DUX * st + k] = du[2 * j], pk[PK_DUY * st + k] = du[2 * j + 1];
-    pk[PK_RHO * st + k] = rho[j];
+    pk[RHOD_PK_D * st + k] = D[j];
+    pk[RHOD_PK_GPX * st + k] = gP[2 * j], pk[RHOD_PK_GPY * st + k] = gP[2 * j + 1];
+    pk[RHOD_PK_GU0 * st + k] = gu[4 * j], pk[RHOD_PK_GU1 * st + k] = gu[4 * j + 1];
+    pk[RHOD_PK_GU2 * st + k] = gu[4 * j + 2], pk[RHOD_PK_GU3 * st + k] = gu[4 * j + 3];
+    pk[RHOD_PK_DUX * st + k] = du[2 * j], pk[RHOD_PK_DUY * st + k] = du[2 * j + 1];
+    pk[RHOD_PK_RHO * st + k] = rho[j];
   }
 }
 
@@ -226,8 +194,9 @@ static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   G, CS, x, y, ux, uy, dx, P, V, pk, st, gam, ggam, L, gP, gu, D, gC, uch, lam, lapB, ratio, vcons
 
 PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
-  const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st, *kP = pk + PK_P * st,
-             *kux = pk + PK_UX * st, *kuy = pk + PK_UY * st, *kdx = pk + PK_DX * st;
+  const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
+             *kP = pk + RHOD_PK_P * st, *kux = pk + RHOD_PK_UX * st, *kuy = pk + RHOD_PK_UY * st,
+             *kdx = pk + RHOD_PK_DX * st;
   const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
   const real uxi = ux[i], uyi = uy[i], Pi = P[i], dxi = dx[i];
   const real iR = 1 / Ri, iR2 = iR * iR, iR3 = iR2 * iR;
@@ -437,7 +406,9 @@ void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells
     return;
   }
   const rhod_grid G = c->g;
-  const int32_t *CS = c->start, *CI = c->idx;
+  const int32_t *CS = c->start;
+  const real *pk = s->pk;
+  const long st = (long)p->cap;
   const real lo = s->lam_lo, hi = s->lam_hi, ratio = s->ratio;
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
@@ -461,25 +432,31 @@ void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells
       fs[i] = 0;
       continue;
     }
+    /* the scan region: is any neighbour j in the umbrella-shaped region around T = x_i
+     * + h n (Marrone et al. 2010)? Over pass A's packed positions (vectorised lanes);
+     * j = i is left out by r > 0 (a neighbour exactly on top of i would be too, and
+     * would not count anyway: it lies at |n.q| + |t.q| = h, not inside) */
+    const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st;
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], h = (real)0.5 * Ri;
     const real Tx = xi + h * nx, Ty = yi + h * ny;
     const real tx = -ny, ty = nx;
     const real h2 = h * h, s2h2 = 2 * h2, R2 = Ri * Ri;
-    int occupied = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
-      if (j != i && r2 < R2) {
-        const real qx = x[j] - Tx, qy = y[j] - Ty;
-        if (r2 >= s2h2) {
-          if (qx * qx + qy * qy < h2)
-            occupied = 1;
-        } else if (fabs(nx * qx + ny * qy) + fabs(tx * qx + ty * qy) < h) {
-          occupied = 1;
-        }
+    real RHOD_LANES(socc);
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+      RHOD_FOR_LANES(k0, kv, k) {
+        const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
+        const real qx = kx[k] - Tx, qy = ky[k] - Ty;
+        /* q inside the circle of radius h about T beyond sqrt 2 h from i, inside the
+         * square of half-diagonal h nearer: a negative value (reals, not ints, so that
+         * the loop takes the lanes of the reals) */
+        const real in = r2 >= s2h2 ? qx * qx + qy * qy - h2
+                                   : fabs(nx * qx + ny * qy) + fabs(tx * qx + ty * qy) - h;
+        RHOD_LANE(socc) = r2 < R2 && r2 > 0 && in < 0 ? 1 : RHOD_LANE(socc);
       }
+      RHOD_END_LANES
     }
-    RHOD_END_NEIGHBOURS
-    fs[i] = occupied ? 0 : 1;
+    RHOD_END_ROWS
+    fs[i] = RHOD_LANES_MAX(socc) > 0 ? 0 : 1;
   }
 }
 
@@ -525,8 +502,8 @@ PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
     nt[2 * i] = 0, nt[2 * i + 1] = 0;
     return;
   }
-  const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kf = pk + PK_FS * st,
-             *knx = pk + PK_NX * st, *kny = pk + PK_NY * st;
+  const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kf = pk + RHOD_PK_FS * st,
+             *knx = pk + RHOD_PK_NX * st, *kny = pk + RHOD_PK_NY * st;
   const real iR = 1 / Ri;
   real RHOD_LANES(ssx), RHOD_LANES(ssy), RHOD_LANES(sd2), RHOD_LANES(sany);
   RHOD_LANES_SET(sd2, R2);
@@ -584,8 +561,8 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nt_; k++) {
     const int j = CI[k];
-    pk[PK_FS * st + k] = fs[j] ? 1 : 0;
-    pk[PK_NX * st + k] = nrm[2 * j], pk[PK_NY * st + k] = nrm[2 * j + 1];
+    pk[RHOD_PK_FS * st + k] = fs[j] ? 1 : 0;
+    pk[RHOD_PK_NX * st + k] = nrm[2 * j], pk[RHOD_PK_NY * st + k] = nrm[2 * j + 1];
   }
   const int kern = s->kernel, generic = s->generic;
   const real ratio = s->ratio;
@@ -715,12 +692,13 @@ enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4 };
 
 PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int riemann,
                                    const int recon, const int shifting, const int visc) {
-  const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st, *kP = pk + PK_P * st,
-             *kux = pk + PK_UX * st, *kuy = pk + PK_UY * st, *kdx = pk + PK_DX * st,
-             *kD = pk + PK_D * st, *kgPx = pk + PK_GPX * st, *kgPy = pk + PK_GPY * st,
-             *kg0 = pk + PK_GU0 * st, *kg1 = pk + PK_GU1 * st, *kg2 = pk + PK_GU2 * st,
-             *kg3 = pk + PK_GU3 * st, *kdux = pk + PK_DUX * st, *kduy = pk + PK_DUY * st,
-             *krho = pk + PK_RHO * st;
+  const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
+             *kP = pk + RHOD_PK_P * st, *kux = pk + RHOD_PK_UX * st, *kuy = pk + RHOD_PK_UY * st,
+             *kdx = pk + RHOD_PK_DX * st, *kD = pk + RHOD_PK_D * st, *kgPx = pk + RHOD_PK_GPX * st,
+             *kgPy = pk + RHOD_PK_GPY * st, *kg0 = pk + RHOD_PK_GU0 * st,
+             *kg1 = pk + RHOD_PK_GU1 * st, *kg2 = pk + RHOD_PK_GU2 * st,
+             *kg3 = pk + RHOD_PK_GU3 * st, *kdux = pk + RHOD_PK_DUX * st,
+             *kduy = pk + RHOD_PK_DUY * st, *krho = pk + RHOD_PK_RHO * st;
   const real c0 = K.c0, rho0 = K.rho0, ic2 = K.ic2;
   const real xi = x[i], yi = y[i], dxi = dx[i], Ri = K.ratio * dxi, R2 = Ri * Ri;
   const real iR = 1 / Ri, iR3 = iR * iR * iR;
@@ -1033,14 +1011,14 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nt; k++) {
     const int j = CI[k];
-    pk[PK_X * st + k] = x[j], pk[PK_Y * st + k] = y[j], pk[PK_V * st + k] = V[j];
-    pk[PK_UX * st + k] = v[2 * j], pk[PK_UY * st + k] = v[2 * j + 1];
+    pk[RHOD_PK_X * st + k] = x[j], pk[RHOD_PK_Y * st + k] = y[j], pk[RHOD_PK_V * st + k] = V[j];
+    pk[RHOD_PK_UX * st + k] = v[2 * j], pk[RHOD_PK_UY * st + k] = v[2 * j + 1];
   }
   /* D of the iterate (Eq. 5) and its renormalised gradient (Eqs. 8 and 14, as pass A) */
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
-    const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st,
-               *kvx = pk + PK_UX * st, *kvy = pk + PK_UY * st;
+    const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
+               *kvx = pk + RHOD_PK_UX * st, *kvy = pk + RHOD_PK_UY * st;
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
     const real iR = 1 / Ri, iR3 = iR * iR * iR, vxi = v[2 * i], vyi = v[2 * i + 1];
     real RHOD_LANES(sB0), RHOD_LANES(sB1), RHOD_LANES(sB2), RHOD_LANES(sB3);
@@ -1080,7 +1058,7 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
   }
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nt; k++)
-    pk[PK_D * st + k] = aD[CI[k]];
+    pk[RHOD_PK_D * st + k] = aD[CI[k]];
   /* F^AD / rho of the iterate (Eq. 9, h_i = R_i / 2 as in pass C), which becomes the next
    * iterate; |A v| / |v| estimates the largest |lambda|. The norms are summed in loops
    * of their own, so that the gather needs no reduction (RHOD_GATHER_LOOP) */
@@ -1090,8 +1068,8 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     n0 += v[2 * i] * v[2 * i] + v[2 * i + 1] * v[2 * i + 1];
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
-    const real *kx = pk + PK_X * st, *ky = pk + PK_Y * st, *kV = pk + PK_V * st,
-               *kD = pk + PK_D * st;
+    const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
+               *kD = pk + RHOD_PK_D * st;
     const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri, Di = aD[i];
     const real iR = 1 / Ri, iR3 = iR * iR * iR;
     real RHOD_LANES(sfx), RHOD_LANES(sfy);

@@ -115,12 +115,12 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
  * out: the body's own test r < R rejects them, no extra test is needed, and none is
  * counted twice (each row is scanned once). */
 #if RHOD_VLANES > 1
-#define RHOD_ROW_END_(k0, k1, kn)                                                                  \
-  const int kv_r_ = (k0) + ((k1) - (k0) + RHOD_VLANES - 1) / RHOD_VLANES * RHOD_VLANES;            \
-  const int kv = kv_r_ < (kn) ? kv_r_ : (kn);                                                      \
+#define RHOD_ROW_END_(k0, k1, kn, kv)                                                              \
+  const int kv##_r_ = (k0) + ((k1) - (k0) + RHOD_VLANES - 1) / RHOD_VLANES * RHOD_VLANES;          \
+  const int kv = kv##_r_ < (kn) ? kv##_r_ : (kn);                                                  \
   (void)kv;
 #else
-#define RHOD_ROW_END_(k0, k1, kn)                                                                  \
+#define RHOD_ROW_END_(k0, k1, kn, kv)                                                              \
   const int kv = (k1);                                                                             \
   (void)kv;
 #endif
@@ -135,7 +135,7 @@ static inline int rhod_cell_reach(rhod_grid G, real R) {
     const int x1_ = cx_ + rc_ < (G).nx - 1 ? cx_ + rc_ : (G).nx - 1;                               \
     for (int yy_ = y0_; yy_ <= y1_; yy_++) {                                                       \
       const int k0 = (CS)[yy_ * (G).nx + x0_], k1 = (CS)[yy_ * (G).nx + x1_ + 1];                  \
-      RHOD_ROW_END_(k0, k1, (CS)[yy_ * (G).nx + (G).nx])
+      RHOD_ROW_END_(k0, k1, (CS)[yy_ * (G).nx + (G).nx], kv)
 #define RHOD_END_ROWS                                                                              \
   }                                                                                                \
   }

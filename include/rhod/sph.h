@@ -11,6 +11,39 @@
 /* rhod_sph_dt's binding limit */
 enum { RHOD_DT_BY_EQ11, RHOD_DT_BY_DAMPER, RHOD_DT_BY_STIFFNESS };
 
+/* Rows of rhod_sph.pk: the neighbour-side fields of the gathers, copied into the order
+ * of the sorted cells (row r of particle CI[k] at pk[r * cap + k]), so that the inner
+ * loops over a row of cells read them contiguously and vectorise (RHOD_FOR_ROWS).
+ * Pass A packs the first rows (the state), pass C the rest (pass A's gradients, the
+ * shifting velocity and rho). The cells must have been built over the fluid and the
+ * ghosts. After a right-hand side (rhod_sph_rhs) both sets hold that stage's values,
+ * which the refinement criteria read (rhod_apr_mark). */
+enum {
+  RHOD_PK_X,
+  RHOD_PK_Y,
+  RHOD_PK_V,
+  RHOD_PK_P,
+  RHOD_PK_UX,
+  RHOD_PK_UY,
+  RHOD_PK_DX, /* the rows above: pass A's */
+  RHOD_PK_D,
+  RHOD_PK_GPX,
+  RHOD_PK_GPY,
+  RHOD_PK_GU0,
+  RHOD_PK_GU1,
+  RHOD_PK_GU2,
+  RHOD_PK_GU3,
+  RHOD_PK_DUX,
+  RHOD_PK_DUY,
+  RHOD_PK_RHO, /* from RHOD_PK_D: pass C's */
+  RHOD_PK_ROWS,
+  /* the region pass's rows, in pass C's (packed again by pass C after it): the
+   * free-surface flag (0 or 1) and normal */
+  RHOD_PK_FS = RHOD_PK_D,
+  RHOD_PK_NX = RHOD_PK_GPX,
+  RHOD_PK_NY = RHOD_PK_GPY
+};
+
 typedef struct {
   /* parameters (from the scene) */
   int kernel;
@@ -49,7 +82,7 @@ typedef struct {
   real *drho, *acc, *vel; /* time derivatives: d rho/dt, du/dt (2), dx/dt (2) */
   uint8_t *fs;            /* 1: free-surface particle (set F) */
   uint8_t *reg;           /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
-  real *pk;               /* neighbour-side fields packed in cell order (rhod_sph.c) */
+  real *pk;               /* neighbour-side fields packed in cell order (RHOD_PK_*) */
   real *adv;              /* with adlim: the damper probe's iterate (2, carried across
                              steps and checkpointed), its divergence (adD, 1) and gradient
                              (adG, 4) */
@@ -67,7 +100,9 @@ void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt);
 void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p);
 
 /* The passes of one right-hand side, in the order rhod_sph_rhs runs them (public for
- * the per-pass benchmarks): */
+ * the per-pass benchmarks). The free-surface detection and the region pass read the
+ * positions that pass A packed in cell order, so each follows pass A over the same
+ * cells: */
 void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p);
 void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
