@@ -75,8 +75,8 @@ static void map_free(int32_t **p, size_t n) {
   *p = NULL;
 }
 
-int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double radius, int reach,
-                    size_t cap) {
+static int init_lattice(rhod_cells *c, const double lo[2], const double hi[2], double radius,
+                        int reach, size_t cap) {
   memset(c, 0, sizeof *c);
   if (reach < 1)
     return RHOD_ERR_SCENE;
@@ -103,13 +103,23 @@ int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], doubl
   c->ncells_box = c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   map_alloc(&c->start, c->ncells_box + 1);
   map_alloc(&c->count, c->ncells_box + 1);
-  c->mark = rhod_dev_calloc(c->ncells_box, sizeof(int32_t));
-  if (!c->start || !c->count || !c->mark)
+  if (!c->start || !c->count)
     return RHOD_ERR_MEMORY;
   return rhod_cells_reserve(c, cap);
 }
 
+int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double radius, int reach,
+                    size_t cap) {
+  int st = init_lattice(c, lo, hi, radius, reach, cap);
+  if (st != RHOD_OK)
+    return st;
+  c->sub = malloc(sizeof *c->sub);
+  return c->sub ? init_lattice(c->sub, lo, hi, radius, reach, cap) : RHOD_ERR_MEMORY;
+}
+
 int rhod_cells_reserve(rhod_cells *c, size_t cap) {
+  if (c->sub && rhod_cells_reserve(c->sub, cap) != RHOD_OK)
+    return RHOD_ERR_MEMORY;
   if (cap <= c->cap && c->idx)
     return RHOD_OK;
   map_free(&c->idx, c->cap);
@@ -121,17 +131,23 @@ int rhod_cells_reserve(rhod_cells *c, size_t cap) {
 }
 
 void rhod_cells_free(rhod_cells *c) {
+  if (c->sub) {
+    rhod_cells_free(c->sub);
+    free(c->sub);
+    c->sub = NULL;
+  }
   map_free(&c->start, c->ncells_box + 1);
   map_free(&c->count, c->ncells_box + 1);
-  rhod_dev_free(c->mark, c->ncells_box * sizeof(int32_t));
-  c->mark = NULL;
   map_free(&c->idx, c->cap);
   map_free(&c->key, c->cap);
 }
 
+static long sort_keys(rhod_cells *c, const int32_t *key, const uint8_t *flag, long n);
+
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count) {
-  int32_t *key = c->key, *cnt = c->count, *start = c->start, *idx = c->idx;
+  int32_t *key = c->key;
   const long n = (long)count;
+  c->nbuilt = n;
   /* the window: the lowest and highest occupied cells of the box's lattice */
   {
     const real ox = c->g.ox, oy = c->g.oy, inv = c->g.inv;
@@ -158,7 +174,21 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
     c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   }
   const rhod_grid G = c->g;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const int cx = rhod_cell_coord(x[i], G.ox, G.inv, G.cx0, G.nx);
+    const int cy = rhod_cell_coord(y[i], G.oy, G.inv, G.cy0, G.ny);
+    key[i] = cy * G.nx + cx;
+  }
+  (void)sort_keys(c, key, NULL, n);
+}
+
+/* The counting sort of particles [0, n) by their cells key (those with flag != 0 only,
+ * unless flag is NULL) into c's start and idx; returns how many were sorted. */
+static long sort_keys(rhod_cells *c, const int32_t *key, const uint8_t *flag, long n) {
+  int32_t *cnt = c->count, *start = c->start, *idx = c->idx;
   const long nc = (long)c->ncells;
+  const int all = flag == NULL;
 
   RHOD_KERNEL_LOOP
   for (long k = 0; k <= nc; k++)
@@ -166,15 +196,13 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
 
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
-    const int cx = rhod_cell_coord(x[i], G.ox, G.inv, G.cx0, G.nx);
-    const int cy = rhod_cell_coord(y[i], G.oy, G.inv, G.cy0, G.ny);
-    const int k = cy * G.nx + cx;
-    key[i] = k;
+    if (all || flag[i]) {
 #pragma omp atomic update
-    cnt[k] += 1;
+      cnt[key[i]] += 1;
+    }
   }
 
-  rhod_scan_exclusive(cnt, (size_t)nc + 1);
+  const long total = rhod_scan_exclusive(cnt, (size_t)nc + 1);
 
   RHOD_KERNEL_LOOP
   for (long k = 0; k <= nc; k++)
@@ -183,10 +211,12 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
   /* scatter; the slot order inside a cell depends on thread timing ... */
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
-    int slot;
+    if (all || flag[i]) {
+      int slot;
 #pragma omp atomic capture
-    slot = cnt[key[i]]++;
-    idx[slot] = (int32_t)i;
+      slot = cnt[key[i]]++;
+      idx[slot] = (int32_t)i;
+    }
   }
 
   /* ... so each cell is then put in index order (insertion sort: cells are small),
@@ -204,22 +234,11 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
       idx[t + 1] = v;
     }
   }
+  return total;
 }
 
-void rhod_cells_mark(rhod_cells *c, const uint8_t *flag) {
-  const int32_t *start = c->start, *idx = c->idx;
-  int32_t *mark = c->mark;
-  const long nx = c->g.nx, ny = c->g.ny;
-  /* one row per thread, the running count along it (rows are a few hundred cells) */
-  RHOD_KERNEL_LOOP
-  for (long r = 0; r < ny; r++) {
-    int32_t a = 0;
-    for (long k = r * nx; k < (r + 1) * nx; k++) {
-      int32_t m = 0;
-      for (int s = start[k]; s < start[k + 1] && !m; s++)
-        m = flag[idx[s]] != 0;
-      a += m;
-      mark[k] = a;
-    }
-  }
+long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag) {
+  rhod_cells *u = c->sub;
+  u->g = c->g, u->ncells = c->ncells; /* the window of the last build */
+  return c->nsub = sort_keys(u, c->key, flag, c->nbuilt);
 }

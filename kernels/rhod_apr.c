@@ -191,8 +191,10 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real *kuy = s->pk + RHOD_PK_UY * st, *krho = s->pk + RHOD_PK_RHO * st;
   const real *seg = b->seg, *circ = b->circ;
   const int nseg = b->nseg, ncirc = b->ncirc;
-  const uint8_t *reg = s->reg, *fs = s->fs, *near = a->near, *near2 = a->near2;
-  const int32_t *cmark = c->mark;
+  const uint8_t *reg = s->reg, *near = a->near, *near2 = a->near2;
+  /* the free-surface particles alone (the region pass's subset of the cells) */
+  const rhod_grid Gf = c->sub->g;
+  const int32_t *CSf = c->sub->start, *CIf = c->sub->idx;
   const real *sig = s->sig;
   uint8_t *mark = a->mark;
   real *sd = a->sd, *sp = a->sp;
@@ -243,9 +245,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i])) {
       /* Coalescing candidate: the criteria for the particle of size D = e dx_i at x_i
        * (HYST above). Criterion 3 first: no free-surface particle within HYST f e R_i,
-       * looked for only where the per-cell flags of the region pass put one in reach
-       * (the cells' square reaches up to sqrt 2 times farther than the circle, which
-       * kept a band that much wider fine), then one pass over the support e R_i:
+       * looked for among the free-surface particles alone (the cells' subset that the
+       * region pass sorted), then one pass over the support e R_i:
        * no particle of size dx_i/e or less (criterion 1: it would be D/e^2) and the
        * Shepard field inside the thresholds with margin (criterion 5). Criterion 2
        * needs the other candidates too (coalesce_c2): the sum of Gamma over sizes >= D
@@ -253,10 +254,10 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
       const real RD = eps * Ri, iRD = 1 / RD, iRD2 = iRD * iRD;
       const real RH = HYST * band * RD, RH2 = RH * RH;
       int ok = 1;
-      if (c3 && rhod_cells_near_mark(G, cmark, xi, yi, RH)) {
-        RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RH, j) {
+      if (c3) {
+        RHOD_FOR_NEIGHBOURS(Gf, CSf, CIf, xi, yi, RH, j) {
           const real rx = x[j] - xi, ry = y[j] - yi;
-          ok &= !(fs[j] && rx * rx + ry * ry < RH2);
+          ok &= !(rx * rx + ry * ry < RH2);
         }
         RHOD_END_NEIGHBOURS
       }

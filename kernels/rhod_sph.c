@@ -486,31 +486,31 @@ void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p) {
  * refinement.surface_band (rhod_apr_mark) reads d_i / R_i back as 1 - sigma_i: a change
  * of sigma's definition must change it too (test_apr's direct sum fails otherwise). */
 #define RG_PARAMS                                                                                  \
-  rhod_grid G, const int32_t *CS, const int32_t *mark, const real *x, const real *y,               \
-      const real *dx, const uint8_t *fs, const real *pk, long st, uint8_t *reg, real *nt,          \
-      real *sig, const real ratio
-#define RG_ARGS G, CS, mark, x, y, dx, fs, pk, st, reg, nt, sig, ratio
+  rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *dx, const uint8_t *fs, \
+      const real *pk, long st, uint8_t *reg, real *nt, real *sig, const real ratio
+#define RG_ARGS G, CS, x, y, dx, fs, pk, st, reg, nt, sig, ratio
 
 /* One particle's gather of the region pass (an inlined function, specialised for the
- * default kernel on the host as pass A's) over the packed flags and normals: the sum of
- * W n_j over the free-surface particles j in the support (i itself included) and the
- * nearest of them other than i (r > 0, as PAIR_OR_SKIP). */
+ * default kernel on the host as pass A's) over the free-surface particles alone (the
+ * cells' subset, G and CS, with their positions and normals packed in its order): the
+ * sum of W n_j over those in the support (i itself included) and the nearest of them
+ * other than i (r > 0, as PAIR_OR_SKIP). */
 PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
   const real xi = x[i], yi = y[i], Ri = ratio * dx[i], R2 = Ri * Ri;
-  if (!rhod_cells_near_mark(G, mark, xi, yi, Ri)) {
+  if (!rhod_cells_near_any(G, CS, xi, yi, Ri)) {
     reg[i] = 0, sig[i] = 0;
     nt[2 * i] = 0, nt[2 * i + 1] = 0;
     return;
   }
-  const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kf = pk + RHOD_PK_FS * st,
-             *knx = pk + RHOD_PK_NX * st, *kny = pk + RHOD_PK_NY * st;
+  const real *kx = pk + RHOD_PK_FX * st, *ky = pk + RHOD_PK_FY * st, *knx = pk + RHOD_PK_FNX * st,
+             *kny = pk + RHOD_PK_FNY * st;
   const real iR = 1 / Ri;
   real RHOD_LANES(ssx), RHOD_LANES(ssy), RHOD_LANES(sd2), RHOD_LANES(sany);
   RHOD_LANES_SET(sd2, R2);
   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
     RHOD_FOR_LANES(k0, kv, k) {
       const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
-      if (!(r2 < R2 && kf[k] > 0))
+      if (!(r2 < R2))
         continue;
       const real w = rhod_Wq(kern, sqrt(r2) * iR); /* W R^2: nt is normalised below */
       RHOD_LANE(ssx) += w * knx[k], RHOD_LANE(ssy) += w * kny[k];
@@ -549,20 +549,18 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
     }
     return;
   }
-  /* most particles have no free-surface particle in reach: a per-cell flag lets
-   * them skip the gather */
-  rhod_cells_mark(c, fs);
-  const long nt_ = (long)(p->n + p->ng), st = (long)p->cap;
-  const rhod_grid G = c->g;
-  const int32_t *CS = c->start, *CI = c->idx;
-  const int32_t *mark = c->mark;
+  /* the free-surface particles (fluid and ghosts) sorted into the cells alone, so that
+   * the gather visits only them, and a particle with none in reach skips it; their
+   * positions and normals packed in that order */
+  const long nf = rhod_cells_build_subset(c, fs), st = (long)p->cap;
+  const rhod_grid G = c->sub->g;
+  const int32_t *CS = c->sub->start, *CI = c->sub->idx;
   real *pk = s->pk;
-  /* the flags and normals in the cells' order, next to pass A's packed positions */
   RHOD_KERNEL_LOOP
-  for (long k = 0; k < nt_; k++) {
+  for (long k = 0; k < nf; k++) {
     const int j = CI[k];
-    pk[RHOD_PK_FS * st + k] = fs[j] ? 1 : 0;
-    pk[RHOD_PK_NX * st + k] = nrm[2 * j], pk[RHOD_PK_NY * st + k] = nrm[2 * j + 1];
+    pk[RHOD_PK_FX * st + k] = x[j], pk[RHOD_PK_FY * st + k] = y[j];
+    pk[RHOD_PK_FNX * st + k] = nrm[2 * j], pk[RHOD_PK_FNY * st + k] = nrm[2 * j + 1];
   }
   const int kern = s->kernel, generic = s->generic;
   const real ratio = s->ratio;

@@ -103,16 +103,33 @@ static long gather_mismatches(const rhod_particles *p, rhod_grid G, const int32_
   return bad;
 }
 
-/* rhod_cells_near_mark against brute force: for every particle i (R_i = 4 dx_i), whether
- * some flagged particle lies in a cell within reach of i's cell (the cells of the
- * scan). Returns the particles where the two differ; counts those near a mark. */
+/* The cells' subset of the flagged particles (rhod_cells_build_subset) against the full
+ * sort: the same window, and in every cell the flagged entries of the cell's slice, in
+ * their order; then rhod_cells_near_any on the subset against brute force: for every
+ * particle i (R_i = 4 dx_i), whether some flagged particle lies in a cell within reach
+ * of i's cell (the cells of the scan). Returns the particles where the two differ
+ * (and 1 for a subset that differs); counts those near a flagged one. */
 static long near_mark_mismatches(const rhod_particles *p, rhod_cells *c, const uint8_t *flag,
                                  long *near) {
-  rhod_cells_mark(c, flag);
-  rhod_to_host(c->mark, c->ncells * sizeof(int32_t));
+  const long nf = rhod_cells_build_subset(c, flag);
+  const rhod_cells *u = c->sub;
+  rhod_to_host(u->start, (c->ncells + 1) * sizeof(int32_t));
+  rhod_to_host(u->idx, p->n * sizeof(int32_t));
   const rhod_grid G = c->g;
   const long n = (long)p->n;
-  long bad = 0;
+  long bad = 0, want_nf = 0;
+  for (long i = 0; i < n; i++)
+    want_nf += flag[i] != 0;
+  bad += nf != want_nf || c->nsub != nf || u->start[c->ncells] != nf;
+  bad += u->g.nx != G.nx || u->g.ny != G.ny || u->g.cx0 != G.cx0 || u->g.cy0 != G.cy0 ||
+         u->g.inv != G.inv || u->g.ox != G.ox || u->g.oy != G.oy || u->g.reach != G.reach;
+  for (size_t k = 0; k < c->ncells && !bad; k++) {
+    int s = u->start[k];
+    for (int q = c->start[k]; q < c->start[k + 1]; q++)
+      if (flag[c->idx[q]])
+        bad += s >= u->start[k + 1] || u->idx[s++] != c->idx[q];
+    bad += s != u->start[k + 1];
+  }
   *near = 0;
   for (long i = 0; i < n; i++) {
     const real Ri = 4 * p->dx[i];
@@ -123,7 +140,7 @@ static long near_mark_mismatches(const rhod_particles *p, rhod_cells *c, const u
     for (long j = 0; j < n && !want; j++)
       want = flag[j] && abs(rhod_cell_coord(p->x[j], G.ox, G.inv, G.cx0, G.nx) - cx) <= rc &&
              abs(rhod_cell_coord(p->y[j], G.oy, G.inv, G.cy0, G.ny) - cy) <= rc;
-    const int got = rhod_cells_near_mark(G, c->mark, p->x[i], p->y[i], Ri);
+    const int got = rhod_cells_near_any(u->g, u->start, p->x[i], p->y[i], Ri);
     *near += got;
     bad += got != want;
   }

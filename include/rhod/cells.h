@@ -37,7 +37,7 @@ typedef struct {
   int reach;    /* cells scanned on each side by a particle of radius R0 */
 } rhod_grid;
 
-typedef struct {
+typedef struct rhod_cells {
   rhod_grid g;
   size_t ncells;      /* cells of the window: g.nx * g.ny */
   int nx_box, ny_box; /* the lattice over the whole box */
@@ -46,8 +46,13 @@ typedef struct {
   int32_t *count;     /* ncells: histogram scratch */
   int32_t *idx;       /* cap: particle indices sorted by cell */
   int32_t *key;       /* cap: cell of each particle */
-  int32_t *mark;      /* ncells: marked cells of the row up to this one (rhod_cells_mark) */
   size_t cap;
+  long nbuilt; /* particles sorted by the last build */
+  /* The flagged particles of the last build alone, in the same cells and window
+   * (rhod_cells_build_subset): its start counts them cell by cell, its idx lists them
+   * (indices of the particles of the build). Allocated with the grid; none in a subset. */
+  struct rhod_cells *sub;
+  long nsub; /* particles in the subset */
 } rhod_cells;
 
 /* Sets up a grid over [lo, hi] for kernel radii of at least `radius` (R0), with cells
@@ -62,11 +67,11 @@ void rhod_cells_free(rhod_cells *c);
  * still scans every particle within reach of it. */
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count);
 
-/* A cell is marked when some particle in it has flag != 0 (flags of the particles
- * sorted by the last build); mark[c] counts the marked cells of c's row up to and
- * including c, so that a range of a row is tested with two reads. Lets a gather skip
- * particles with no flagged particle in reach (rhod_cells_near_mark). */
-void rhod_cells_mark(rhod_cells *c, const uint8_t *flag);
+/* Sorts the particles of the last build with flag != 0 into c->sub (the same cells,
+ * in index order inside each); returns how many (c->nsub). A gather over the subset
+ * scans c->sub's rows, which hold only flagged particles, and a range of a row is
+ * tested for any with two reads of its start (rhod_cells_near_any). */
+long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag);
 
 /* Cell coordinate of a position along one axis in the window [off, off + n) of the
  * lattice with origin o, relative to the window, clamped to it. */
@@ -213,10 +218,11 @@ static inline real rhod_lanes_min_(const real *s) {
 #define RHOD_LANES_MIN(s) (s)
 #endif
 
-/* 1 when a cell within reach of a support of radius R at (x, y) is marked (inside
- * device regions: pass a local copy of c->mark). */
-static inline int rhod_cells_near_mark_(const int32_t *mark, real ox, real oy, real inv, int cx0,
-                                        int cy0, int nx, int ny, int rc, real x, real y) {
+/* 1 when a cell within reach of a support of radius R at (x, y) holds a particle, for
+ * the cell starts CS of a grid G (inside device regions: pass local copies; the
+ * subset's, c->sub, for "a flagged particle in reach"): two reads per row. */
+static inline int rhod_cells_near_any_(const int32_t *CS, real ox, real oy, real inv, int cx0,
+                                       int cy0, int nx, int ny, int rc, real x, real y) {
   const int cx = rhod_cell_coord(x, ox, inv, cx0, nx);
   const int cy = rhod_cell_coord(y, oy, inv, cy0, ny);
   const int y0 = cy - rc > 0 ? cy - rc : 0;
@@ -224,17 +230,17 @@ static inline int rhod_cells_near_mark_(const int32_t *mark, real ox, real oy, r
   const int x0 = cx - rc > 0 ? cx - rc : 0;
   const int x1 = cx + rc < nx - 1 ? cx + rc : nx - 1;
   for (int yy = y0; yy <= y1; yy++) {
-    const int32_t *row = mark + (long)yy * nx;
-    if (row[x1] - (x0 > 0 ? row[x0 - 1] : 0) > 0)
+    const int32_t *row = CS + (long)yy * nx;
+    if (row[x1 + 1] > row[x0])
       return 1;
   }
   return 0;
 }
 /* (the grid's fields are passed one by one: GCC 12's nvptx offload compiler fails with
  * an internal error on this struct passed by value to an inline function here) */
-#define rhod_cells_near_mark(G, mark, x, y, R)                                                     \
-  rhod_cells_near_mark_((mark), (G).ox, (G).oy, (G).inv, (G).cx0, (G).cy0, (G).nx, (G).ny,         \
-                        rhod_cell_reach((G), (R)), (x), (y))
+#define rhod_cells_near_any(G, CS, x, y, R)                                                        \
+  rhod_cells_near_any_((CS), (G).ox, (G).oy, (G).inv, (G).cx0, (G).cy0, (G).nx, (G).ny,            \
+                       rhod_cell_reach((G), (R)), (x), (y))
 
 /* Exclusive prefix sum of n ints in place on the device; returns the total. */
 long rhod_scan_exclusive(int32_t *a, size_t n);

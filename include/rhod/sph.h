@@ -17,7 +17,8 @@ enum { RHOD_DT_BY_EQ11, RHOD_DT_BY_DAMPER, RHOD_DT_BY_STIFFNESS };
  * Pass A packs the first rows (the state), pass C the rest (pass A's gradients, the
  * shifting velocity and rho). The cells must have been built over the fluid and the
  * ghosts. After a right-hand side (rhod_sph_rhs) both sets hold that stage's values,
- * which the refinement criteria read (rhod_apr_mark). */
+ * which the refinement criteria read (rhod_apr_mark), and the cells' subset holds that
+ * stage's free-surface particles (the region pass). */
 enum {
   RHOD_PK_X,
   RHOD_PK_Y,
@@ -38,10 +39,12 @@ enum {
   RHOD_PK_RHO, /* from RHOD_PK_D: pass C's */
   RHOD_PK_ROWS,
   /* the region pass's rows, in pass C's (packed again by pass C after it): the
-   * free-surface flag (0 or 1) and normal */
-  RHOD_PK_FS = RHOD_PK_D,
-  RHOD_PK_NX = RHOD_PK_GPX,
-  RHOD_PK_NY = RHOD_PK_GPY
+   * positions and normals of the free-surface particles, in the order of the cells'
+   * subset (rhod_cells_build_subset) */
+  RHOD_PK_FX = RHOD_PK_D,
+  RHOD_PK_FY = RHOD_PK_GPX,
+  RHOD_PK_FNX = RHOD_PK_GPY,
+  RHOD_PK_FNY = RHOD_PK_GU0
 };
 
 typedef struct {
@@ -100,9 +103,8 @@ void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt);
 void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p);
 
 /* The passes of one right-hand side, in the order rhod_sph_rhs runs them (public for
- * the per-pass benchmarks). The free-surface detection and the region pass read the
- * positions that pass A packed in cell order, so each follows pass A over the same
- * cells: */
+ * the per-pass benchmarks). The free-surface detection reads the positions that pass A
+ * packed in cell order, so it follows pass A over the same cells: */
 void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p);
 void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
