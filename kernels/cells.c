@@ -142,7 +142,7 @@ void rhod_cells_free(rhod_cells *c) {
   map_free(&c->key, c->cap);
 }
 
-static long sort_keys(rhod_cells *c, const int32_t *key, const uint8_t *flag, long n);
+static long sort_counted(rhod_cells *c, const int32_t *key, const uint8_t *flag, long n);
 
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count) {
   int32_t *key = c->key;
@@ -174,33 +174,31 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
     c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   }
   const rhod_grid G = c->g;
+  int32_t *cnt = c->count;
+  const long nc = (long)c->ncells;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k <= nc; k++)
+    cnt[k] = 0;
+  /* each particle's key and the histogram in one loop */
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     const int cx = rhod_cell_coord(x[i], G.ox, G.inv, G.cx0, G.nx);
     const int cy = rhod_cell_coord(y[i], G.oy, G.inv, G.cy0, G.ny);
-    key[i] = cy * G.nx + cx;
+    const int k = cy * G.nx + cx;
+    key[i] = k;
+#pragma omp atomic update
+    cnt[k] += 1;
   }
-  (void)sort_keys(c, key, NULL, n);
+  (void)sort_counted(c, key, NULL, n);
 }
 
-/* The counting sort of particles [0, n) by their cells key (those with flag != 0 only,
- * unless flag is NULL) into c's start and idx; returns how many were sorted. */
-static long sort_keys(rhod_cells *c, const int32_t *key, const uint8_t *flag, long n) {
+/* The rest of the counting sort, from the histogram of the keys in c->count: particles
+ * [0, n) (those with flag != 0 only, unless flag is NULL) into c's start and idx;
+ * returns how many were sorted. */
+static long sort_counted(rhod_cells *c, const int32_t *key, const uint8_t *flag, long n) {
   int32_t *cnt = c->count, *start = c->start, *idx = c->idx;
   const long nc = (long)c->ncells;
   const int all = flag == NULL;
-
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k <= nc; k++)
-    cnt[k] = 0;
-
-  RHOD_KERNEL_LOOP
-  for (long i = 0; i < n; i++) {
-    if (all || flag[i]) {
-#pragma omp atomic update
-      cnt[key[i]] += 1;
-    }
-  }
 
   const long total = rhod_scan_exclusive(cnt, (size_t)nc + 1);
 
@@ -240,5 +238,18 @@ static long sort_keys(rhod_cells *c, const int32_t *key, const uint8_t *flag, lo
 long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag) {
   rhod_cells *u = c->sub;
   u->g = c->g, u->ncells = c->ncells; /* the window of the last build */
-  return c->nsub = sort_keys(u, c->key, flag, c->nbuilt);
+  int32_t *cnt = u->count;
+  const int32_t *key = c->key;
+  const long nc = (long)u->ncells, n = c->nbuilt;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k <= nc; k++)
+    cnt[k] = 0;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    if (flag[i]) {
+#pragma omp atomic update
+      cnt[key[i]] += 1;
+    }
+  }
+  return c->nsub = sort_counted(u, key, flag, n);
 }
