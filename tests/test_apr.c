@@ -109,7 +109,7 @@ static long gather_mismatches(const rhod_particles *p, rhod_grid G, const int32_
  * particle i (R_i = 4 dx_i), whether some flagged particle lies in a cell within reach
  * of i's cell (the cells of the scan). Returns the particles where the two differ
  * (and 1 for a subset that differs); counts those near a flagged one. */
-static long near_mark_mismatches(const rhod_particles *p, rhod_cells *c, const uint8_t *flag,
+static long subset_mismatches(const rhod_particles *p, rhod_cells *c, const uint8_t *flag,
                                  long *near) {
   const long nf = rhod_cells_build_subset(c, flag);
   const rhod_cells *u = c->sub;
@@ -191,9 +191,9 @@ static void test_mixed_size_neighbours(void) {
         CU_ASSERT_EQUAL(dups, 0);
         CU_ASSERT(pairs > 40 * (long)p.n); /* about 50 each, fewer at the edges */
         CU_ASSERT(mixed > 2000);           /* the size interfaces are in the test */
-        /* the per-cell marks: a sparse set of flagged particles */
+        /* the free-surface subset and its reach test, on a sparse set of flagged particles */
         long near;
-        const long mbad = near_mark_mismatches(&p, &c, flag, &near);
+        const long mbad = subset_mismatches(&p, &c, flag, &near);
         if (mbad)
           fprintf(stderr, "\nbox %d radius %g reach %d: %ld particles with a wrong mark\n", b,
                   radii[r], reach, mbad);
