@@ -110,7 +110,7 @@ static long gather_mismatches(const rhod_particles *p, rhod_grid G, const int32_
  * of i's cell (the cells of the scan). Returns the particles where the two differ
  * (and 1 for a subset that differs); counts those near a flagged one. */
 static long subset_mismatches(const rhod_particles *p, rhod_cells *c, const uint8_t *flag,
-                                 long *near) {
+                              long *near) {
   const long nf = rhod_cells_build_subset(c, flag);
   const rhod_cells *u = c->sub;
   rhod_to_host(u->start, (c->ncells + 1) * sizeof(int32_t));
