@@ -144,6 +144,16 @@ void rhod_cells_free(rhod_cells *c) {
 
 static long sort_counted(rhod_cells *c, const int32_t *key, const uint8_t *flag, long n);
 
+/* Zeroes the histogram of c's cells (the window's, and the total's slot). */
+static int32_t *clear_counts(rhod_cells *c) {
+  int32_t *cnt = c->count;
+  const long nc = (long)c->ncells;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k <= nc; k++)
+    cnt[k] = 0;
+  return cnt;
+}
+
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count) {
   int32_t *key = c->key;
   const long n = (long)count;
@@ -174,11 +184,7 @@ void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count)
     c->ncells = (size_t)c->g.nx * (size_t)c->g.ny;
   }
   const rhod_grid G = c->g;
-  int32_t *cnt = c->count;
-  const long nc = (long)c->ncells;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k <= nc; k++)
-    cnt[k] = 0;
+  int32_t *cnt = clear_counts(c);
   /* each particle's key and the histogram in one loop */
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
@@ -238,12 +244,9 @@ static long sort_counted(rhod_cells *c, const int32_t *key, const uint8_t *flag,
 long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag) {
   rhod_cells *u = c->sub;
   u->g = c->g, u->ncells = c->ncells; /* the window of the last build */
-  int32_t *cnt = u->count;
+  int32_t *cnt = clear_counts(u);
   const int32_t *key = c->key;
-  const long nc = (long)u->ncells, n = c->nbuilt;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k <= nc; k++)
-    cnt[k] = 0;
+  const long n = c->nbuilt;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     if (flag[i]) {
