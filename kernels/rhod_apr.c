@@ -165,6 +165,7 @@ static void drop_candidates(uint8_t *mark, long n) {
 }
 
 static long group(rhod_apr *a, const rhod_particles *p, const rhod_cells *c);
+static long absorb(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const rhod_cells *c);
 static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
                         const rhod_cells *c);
 
@@ -358,7 +359,9 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     for (long i = 0; i < n; i++)
       ncand += mark[i] == 2;
   }
-  a->groups = ncand >= 4 && coalesce_c2(a, s, p, c) >= 4 ? group(a, p, c) : 0;
+  const long kept = ncand > 0 ? coalesce_c2(a, s, p, c) : 0;
+  a->groups = kept >= a->nsplit ? group(a, p, c) : 0;
+  a->absorbed = kept > a->groups * a->nsplit ? absorb(a, s, p, c) : 0;
   if (ncand > 0)
     drop_candidates(mark, n); /* the candidates left over */
   return RHOD_OK;
@@ -525,6 +528,134 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
   return accepted;
 }
 
+/* Absorption of stragglers (ours, docs/choices.md "APR coalescing"): a candidate left
+ * ungrouped with fewer than N - 1 other particles of its size within 2 dx_i (N = 4, or
+ * 3 for the triangle) can be in no group (a group's members lie within dx_i of their
+ * centre of mass, so within 2 dx_i of each other) and, with no particle of its size
+ * coming near, never will: a fine particle left behind among coarser ones when a
+ * refined region merged back. It keeps the coarser particles around it from merging
+ * in turn (criterion 1 for them). Such a donor i is shared out among the particles
+ * one size coarser (e dx_i, the size its group would have made) within R_a = (1 + e)
+ * dx_i (the first two rings of them on a regular layout: a particle of size dx_i and
+ * one of e dx_i stand (1 + e) dx_i / 2 apart), in the proportions f_ij = W(r_ij; R_a)
+ * / sum_k W(r_ik; R_a): receiver j gains f_ij m_i, f_ij m_i u_i, f_ij V_i and moves to
+ * the centre of mass of itself and its share, so mass, momentum, volume and the centre
+ * of mass are conserved, as in a merge, and the sizes stay the level sizes. A
+ * receiver is not splitting, grouped, or a donor itself, has a volume m_j / rho_j
+ * below ABSORB_VMAX dx_j^2 (so that repeated absorptions cannot inflate one particle
+ * beyond its size: its support stays R_j), and takes at most the four nearest donors
+ * (ties: lower index); a donor no receiver takes stays a candidate. Marks: donor 5,
+ * receiver 6; a receiver keeps its donors in grp and their shares f_ij in sd, which
+ * are free for it (sd is read only for the particles that split). Returns the donors. */
+#define ABSORB_VMAX ((real)1.25)
+/* keeps (d0, j0) .. (d3, j3) the four smallest (d, j), lexicographically */
+#define KEEP4(d, j)                                                                                \
+  if ((d) < d3 || ((d) == d3 && (j) < j3)) {                                                       \
+    d3 = (d), j3 = (j);                                                                            \
+    if (d3 < d2 || (d3 == d2 && j3 < j2)) {                                                        \
+      const real td_ = d2;                                                                         \
+      const int32_t tj_ = j2;                                                                      \
+      d2 = d3, j2 = j3, d3 = td_, j3 = tj_;                                                        \
+      if (d2 < d1 || (d2 == d1 && j2 < j1)) {                                                      \
+        const real ud_ = d1;                                                                       \
+        const int32_t uj_ = j1;                                                                    \
+        d1 = d2, j1 = j2, d2 = ud_, j2 = uj_;                                                      \
+        if (d1 < d0 || (d1 == d0 && j1 < j0)) {                                                    \
+          const real vd_ = d0;                                                                     \
+          const int32_t vj_ = j0;                                                                  \
+          d0 = d1, j0 = j1, d1 = vd_, j1 = vj_;                                                    \
+        }                                                                                          \
+      }                                                                                            \
+    }                                                                                              \
+  }
+
+static long absorb(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *m = p->m, *rho = p->rho;
+  uint8_t *mark = a->mark, *acc = a->acc;
+  int32_t *grp = a->grp, *claim = a->claim;
+  real *sd = a->sd, *sp = a->sp;
+  const int kern = s->kernel, others = a->nsplit - 1;
+  const real eps = a->eps, ieps = a->ieps;
+  /* the donors: candidates with fewer than N - 1 particles of their size within 2 dx_i */
+  RHOD_GATHER_LOOP
+  for (long i = 0; i < n; i++) {
+    acc[i] = 0;
+    if (mark[i] != 2)
+      continue;
+    const real xi = x[i], yi = y[i], dxi = dx[i], reach = 2 * dxi, reach2 = reach * reach;
+    const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
+    int same = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
+      const real rx = x[j] - xi, ry = y[j] - yi;
+      same += j < n && j != i && dx[j] > lo && dx[j] < hi && rx * rx + ry * ry < reach2;
+    }
+    RHOD_END_NEIGHBOURS
+    acc[i] = same < others;
+  }
+  /* the receivers: each lists its four nearest donors i (of size dx_j / e, within R_a of
+   * them) with the weights W(r_ij; R_a) */
+  RHOD_GATHER_LOOP
+  for (long j = 0; j < n; j++) {
+    claim[j] = 0;
+    const real dxj = dx[j];
+    if (!(mark[j] == 0 || mark[j] == 2) || acc[j] || m[j] >= ABSORB_VMAX * rho[j] * dxj * dxj)
+      continue;
+    const real xj = x[j], yj = y[j], dd = dxj * ieps; /* the donors' size */
+    const real lo = dd * (1 - SIZE_TOL), hi = dd * (1 + SIZE_TOL), Ra = (1 + eps) * dd;
+    const real Ra2 = Ra * Ra;
+    real d0 = NONE, d1 = NONE, d2 = NONE, d3 = NONE;
+    int32_t j0 = -1, j1 = -1, j2 = -1, j3 = -1;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xj, yj, Ra, i) {
+      const real rx = x[i] - xj, ry = y[i] - yj, r2 = rx * rx + ry * ry;
+      if (i < n && acc[i] && dx[i] > lo && dx[i] < hi && r2 < Ra2)
+        KEEP4(r2, (int32_t)i);
+    }
+    RHOD_END_NEIGHBOURS
+    grp[4 * j] = j0, grp[4 * j + 1] = j1, grp[4 * j + 2] = j2, grp[4 * j + 3] = j3;
+    const real iRa = 1 / Ra;
+    sd[4 * j] = j0 >= 0 ? rhod_Wq(kern, sqrt(d0) * iRa) : 0;
+    sd[4 * j + 1] = j1 >= 0 ? rhod_Wq(kern, sqrt(d1) * iRa) : 0;
+    sd[4 * j + 2] = j2 >= 0 ? rhod_Wq(kern, sqrt(d2) * iRa) : 0;
+    sd[4 * j + 3] = j3 >= 0 ? rhod_Wq(kern, sqrt(d3) * iRa) : 0;
+    claim[j] = (j0 >= 0) + (j1 >= 0) + (j2 >= 0) + (j3 >= 0);
+  }
+  /* the donors' normalisation: the weights of the receivers that listed them */
+  RHOD_GATHER_LOOP
+  for (long i = 0; i < n; i++) {
+    sp[i] = 0;
+    if (!acc[i])
+      continue;
+    const real xi = x[i], yi = y[i], Ra = (1 + eps) * dx[i];
+    real S = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ra, j) {
+      if (j < n && claim[j] > 0)
+        for (int k = 0; k < 4; k++)
+          S += grp[4 * j + k] == (int32_t)i ? sd[4 * j + k] : 0;
+    }
+    RHOD_END_NEIGHBOURS
+    sp[i] = S;
+  }
+  /* the shares f_ij, and the marks */
+  long donors = 0;
+  RHOD_KERNEL_LOOP_REDUCE(+, donors)
+  for (long q = 0; q < n; q++) {
+    if (claim[q] > 0) {
+      for (int k = 0; k < 4; k++) {
+        const int32_t i = grp[4 * q + k];
+        sd[4 * q + k] = i >= 0 && sp[i] > 0 ? sd[4 * q + k] / sp[i] : 0;
+      }
+      mark[q] = 6;
+    } else if (acc[q] && sp[q] > 0) {
+      mark[q] = 5;
+      donors++;
+    }
+  }
+  return donors;
+}
+
 long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rhod_boundary *b) {
   const long n = (long)p->n;
   a->split_last = 0;
@@ -603,9 +734,10 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
 long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   const long n = (long)p->n, nm = a->n_marked;
   a->merged_last = 0;
-  const long groups = a->groups;
-  a->groups = 0;
-  if (groups == 0 || nm > n)
+  a->absorbed_last = 0;
+  const long groups = a->groups, absorbed = a->absorbed;
+  a->groups = a->absorbed = 0;
+  if ((groups == 0 && absorbed == 0) || nm > n)
     return 0;
   const uint8_t *mark = a->mark;
   const int32_t *grp = a->grp;
@@ -615,24 +747,44 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   const real dx_max = a->dx_max, ieps = a->ieps;
   RHOD_KERNEL_LOOP
   for (long i = 0; i <= nm; i++)
-    cnt[i] = i < nm && mark[i] != 4;
+    cnt[i] = i < nm && mark[i] != 4 && mark[i] != 5;
   /* The merged particle, in the leader's slot (our choice, docs/choices.md): mass
    * m = sum m_k; position and velocity the mass-weighted means (centre of mass and
    * momentum conserved, as in paper 004 Sec. 2.3); volume V = sum m_k / rho_k
    * conserved, so rho = m / V (the inverse of the split's V_c = (V_i rho_i / 4) /
    * rho_c); the next coarser size; the leader's id. The kinetic energy of the members' motion
-   * about their mean is lost (a dissipation the energy probes see). */
-  RHOD_KERNEL_LOOP
+   * about their mean, sum m_k |u_k|^2 / 2 - M |U|^2 / 2, is lost (a dissipation the
+   * energy probes see, summed into a->ke_merged; a receiver's into a->ke_absorbed). */
+  const real *sd = a->sd;
+  real kem = 0, kea = 0;
+  RHOD_KERNEL_LOOP_REDUCE2(+, kem, kea)
   for (long i = 0; i < nm; i++) {
+    if (mark[i] == 6) {
+      /* a receiver of absorbed stragglers (absorb above): its shares f_k of them */
+      real M = m[i], X = m[i] * x[i], Y = m[i] * y[i], U = m[i] * ux[i], W = m[i] * uy[i];
+      real V = m[i] / rho[i], K = m[i] * (ux[i] * ux[i] + uy[i] * uy[i]);
+      for (int k = 0; k < 4; k++) {
+        const int32_t j = grp[4 * i + k];
+        const real f = sd[4 * i + k], mj = j >= 0 ? f * m[j] : 0;
+        const int32_t jj = j >= 0 ? j : (int32_t)i;
+        M += mj, X += mj * x[jj], Y += mj * y[jj], U += mj * ux[jj], W += mj * uy[jj];
+        V += mj / rho[jj], K += mj * (ux[jj] * ux[jj] + uy[jj] * uy[jj]);
+      }
+      x[i] = X / M, y[i] = Y / M, ux[i] = U / M, uy[i] = W / M;
+      m[i] = M, rho[i] = M / V;
+      kea += (real)0.5 * (K - (U * U + W * W) / M);
+      continue;
+    }
     if (mark[i] != 3)
       continue;
-    real M = 0, X = 0, Y = 0, U = 0, W = 0, V = 0;
+    real M = 0, X = 0, Y = 0, U = 0, W = 0, V = 0, K = 0;
     for (int k = 0; k < nsplit; k++) {
       const int32_t j = grp[4 * i + k];
       const real mj = m[j];
       M += mj, X += mj * x[j], Y += mj * y[j], U += mj * ux[j], W += mj * uy[j];
-      V += mj / rho[j];
+      V += mj / rho[j], K += mj * (ux[j] * ux[j] + uy[j] * uy[j]);
     }
+    kem += (real)0.5 * (K - (U * U + W * W) / M);
     x[i] = X / M, y[i] = Y / M, ux[i] = U / M, uy[i] = W / M;
     /* the size one level up, made by the multiplications the splits make from
      * particles.dx, so that it equals the sizes of that level exactly (2 dx at e = 2) */
@@ -645,7 +797,7 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   int32_t *perm = p->perm;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < nm; i++)
-    if (mark[i] != 4)
+    if (mark[i] != 4 && mark[i] != 5)
       perm[cnt[i]] = (int32_t)i;
   /* the children of this step's split stay behind, in order */
   RHOD_KERNEL_LOOP
@@ -656,5 +808,8 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   rhod_particles_permute(p);
   a->merged_last = groups;
   a->merged_total += groups;
+  a->absorbed_last = absorbed;
+  a->absorbed_total += absorbed;
+  a->ke_merged += kem, a->ke_absorbed += kea;
   return groups;
 }

@@ -3,6 +3,7 @@
  *   f64 t next_out next_probe next_checkpoint checkpoint_every
  *   i64 step reflected splits merges (version 2; version 1 has no splits, merges)
  *   f64 stiffness (version 3)
+ *   i64 absorbed, f64 ke_merged ke_absorbed (version 4)
  *   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
  *   str scene_path   i32 nsets, str[nsets]   u32 nparams, (str key, str value)[nparams]
  *   u64 n next_id   i32 nfields, per field: str name, u64 elem, elem * n bytes
@@ -19,8 +20,9 @@
 #include <string.h>
 
 #define CK_MAGIC "RHODCKP1"
-/* 2: the split and merge totals; 3: the stiffness limit's measure; 1 and 2 are still read */
-#define CK_VERSION 3u
+/* 2: the split and merge totals; 3: the stiffness limit's measure; 4: the absorbed
+ * stragglers' total and the energy coalescing took out; 1 to 3 are still read */
+#define CK_VERSION 4u
 #define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
 
 static uint64_t fnv1a(const unsigned char *b, size_t n) {
@@ -83,6 +85,9 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
   put_i64(&w, ck->splits);
   put_i64(&w, ck->merges);
   put_f64(&w, ck->stiffness);
+  put_i64(&w, ck->absorbed);
+  put_f64(&w, ck->ke_merged);
+  put_f64(&w, ck->ke_absorbed);
   put_u64(&w, ck->probes_bytes);
   put_i32(&w, ck->nsnap);
   put(&w, ck->snap_t, sizeof(double) * (size_t)ck->nsnap);
@@ -235,6 +240,11 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   }
   if (version >= 3)
     get(r, &ck->stiffness, 8, "stiffness");
+  if (version >= 4) {
+    get(r, &ck->absorbed, 8, "absorbed count");
+    get(r, &ck->ke_merged, 8, "energy merged");
+    get(r, &ck->ke_absorbed, 8, "energy absorbed");
+  }
   get(r, &ck->probes_bytes, 8, "probes.csv length");
   ck->nsnap = (int32_t)get_count(r, "snapshot count");
   ck->snap_t = get_array(r, (uint64_t)ck->nsnap, sizeof(double), "snapshot times");

@@ -136,6 +136,9 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
   ck.reflected = c->sim.reflected;
   ck.splits = c->sim.apr.split_total;
   ck.merges = c->sim.apr.merged_total;
+  ck.absorbed = c->sim.apr.absorbed_total;
+  ck.ke_merged = c->sim.apr.ke_merged;
+  ck.ke_absorbed = c->sim.apr.ke_absorbed;
   ck.stiffness = c->sim.sph.st_lambda;
   long pos = c->csv.f ? ftell(c->csv.f) : -1;
   ck.probes_bytes = pos > 0 ? (uint64_t)pos : 0;
@@ -202,12 +205,15 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
                         "  \"us_per_particle_step\": %.6g,\n  \"precision\": \"%s\",\n"
                         "  \"threads\": %d,\n  \"kernels_ran_on\": \"%s\",\n"
                         "  \"wall_reflections\": %ld,\n  \"splits\": %ld,\n  \"merges\": %ld,\n"
+                        "  \"absorbed\": %ld,\n  \"merge_dissipation\": %.9g,\n"
+                        "  \"absorb_dissipation\": %.9g,\n"
                         "  \"damper_limited_steps\": %ld,\n  \"stiffness_limited_steps\": %ld,\n"
                         "  \"probes\": {",
                         status, cause, c->sc->path, s->p.n, s->step, s->t, s->dt, wall,
                         psteps > 0 ? 1e6 * wall / psteps : 0.0, RHOD_REAL_NAME,
                         omp_get_max_threads(), c->where, s->reflected, s->apr.split_total,
-                        s->apr.merged_total, s->damper_limited, s->stiffness_limited);
+                        s->apr.merged_total, s->apr.absorbed_total, s->apr.ke_merged,
+                        s->apr.ke_absorbed, s->damper_limited, s->stiffness_limited);
   for (unsigned k = 0; k < c->nprobe_cols && o < sizeof buf - 200; k++)
     o += (size_t)snprintf(buf + o, sizeof buf - o, "%s\n    \"%s\": %.9g", k ? "," : "",
                           c->probe_names[k], c->probe_vals ? c->probe_vals[k] : 0.0);
@@ -345,6 +351,9 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       c.sim.reflected = ck.reflected;
       c.sim.apr.split_total = ck.splits;
       c.sim.apr.merged_total = ck.merges;
+      c.sim.apr.absorbed_total = ck.absorbed;
+      c.sim.apr.ke_merged = ck.ke_merged;
+      c.sim.apr.ke_absorbed = ck.ke_absorbed;
       c.sim.sph.st_lambda = (real)ck.stiffness;
       c.sim.dt = rhod_sph_dt(&c.sim.sph, &c.sim.p); /* sizes may have been split since t = 0 */
       st = rhod_sim_prepare(&c.sim, 1);
@@ -505,9 +514,13 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     logline("rhod: done: %ld steps, %.3f s wall, %.4g us per particle-step", s->step, wall,
             psteps > 0 ? 1e6 * wall / psteps : 0.0);
     if (s->apr.split_total || s->apr.merged_total)
-      logline("rhod: %ld particles split by the refinement criteria and %ld groups of four "
+      logline("rhod: %ld particles split by the refinement criteria and %ld groups of %d "
               "coalesced during the run (%zu particles now)",
-              s->apr.split_total, s->apr.merged_total, s->p.n);
+              s->apr.split_total, s->apr.merged_total, s->apr.nsplit, s->p.n);
+    if (s->apr.merged_total || s->apr.absorbed_total)
+      logline("rhod: %ld stragglers absorbed by their coarser neighbours; the merges took "
+              "%.4g J/m of kinetic energy out, the absorptions %.4g J/m",
+              s->apr.absorbed_total, s->apr.ke_merged, s->apr.ke_absorbed);
     if (s->reflected)
       logline("rhod: %ld particle-steps ended just behind a wall and were reflected back "
               "(docs/choices.md)",

@@ -599,7 +599,7 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
     goto mem;
   }
   rhod_apr_coalesce(&s->apr, p);
-  if (s->apr.split_last > 0 || s->apr.merged_last > 0)
+  if (s->apr.split_last > 0 || s->apr.merged_last > 0 || s->apr.absorbed_last > 0)
     s->dt = rhod_sph_dt(&s->sph, p);
   return RHOD_OK;
 mem:

@@ -35,7 +35,8 @@ typedef struct {
    * between marking and splitting. */
   size_t cap;
   uint8_t *mark;  /* cap: 1 = split at the end of the step; coalescing: 2 candidate,
-                     3 merges its group into itself, 4 merged into another */
+                     3 merges its group into itself, 4 merged into another, 5 a
+                     straggler shared out among its coarser neighbours, 6 one of them */
   uint8_t *near;  /* cap: criterion 4 (support reaches a wall) */
   int32_t *cnt;   /* cap + 1: children written per particle, scanned */
   real *sd;       /* 4 cap: split data: grad P (Eq. 14), unit vector to the nearest neighbour */
@@ -47,8 +48,12 @@ typedef struct {
   real *sp;       /* cap: the proposal's spread (smaller wins), or 1e30 for none */
   long n_marked;  /* fluid particles when marked (coalescing indices are below it) */
   long groups;    /* groups the last marking accepted, for rhod_apr_coalesce */
+  long absorbed;  /* stragglers the last marking shared out (marks 5, receivers 6) */
   long split_last, split_total;   /* particles split by the last call and by the run */
   long merged_last, merged_total; /* groups coalesced by the last call and by the run */
+  long absorbed_last, absorbed_total; /* stragglers absorbed by the last call and the run */
+  double ke_merged, ke_absorbed; /* kinetic energy the merges and the absorptions of the run
+                                    took out (motion about the mean), J per unit depth */
 } rhod_apr;
 
 int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min);

@@ -21,6 +21,8 @@ typedef struct {
   int64_t step, reflected;
   int64_t splits, merges; /* APR totals of the run so far (0 from a version-1 file) */
   double stiffness;       /* the stiffness limit's last measure, 1/s (0 before version 3) */
+  int64_t absorbed;       /* APR stragglers absorbed so far (0 before version 4) */
+  double ke_merged, ke_absorbed; /* the energy coalescing took out so far (idem) */
   uint64_t probes_bytes;  /* length of probes.csv when the checkpoint was taken */
   int32_t nsnap;
   double *snap_t;
