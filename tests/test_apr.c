@@ -1119,7 +1119,8 @@ static void coalesce_groups(rhod_pattern pattern) {
     /* the receivers: the fine particles within (1 + e) h/e of the straggler, by hand */
     donors += a.mark[i] == 5;
     receivers += a.mark[i] == 6;
-    bad_receiver += (a.mark[i] == 6) != (p.dx[i] != (real)dx && i != tiny && dt < (1 + eps) * h / eps);
+    bad_receiver +=
+        (a.mark[i] == 6) != (p.dx[i] != (real)dx && i != tiny && dt < (1 + eps) * h / eps);
     if (a.mark[i] != 3)
       continue;
     leaders++;
@@ -1393,7 +1394,7 @@ static void test_triangle_run(void) {
    * exercised (the split's own count is in "... also with the 1 -> 3 triangle") */
   CU_ASSERT(r.sim->apr.split_total + r.sim->apr.merged_total > 0);
   CU_ASSERT_EQUAL((long)v.n, n0 + 2 * r.sim->apr.split_total - 2 * r.sim->apr.merged_total -
-                                r.sim->apr.absorbed_total);
+                                 r.sim->apr.absorbed_total);
   CU_ASSERT(fabsl(m1 - m0) <= TOL(1e-13) * m0);
   CU_ASSERT(ids_unique(&v, r.sim->p.next_id));
   run_close(&r);

@@ -7,8 +7,11 @@
  * Coalescing (not in paper 002, which leaves it to future work; paper 004 Sec. 2.3
  * merges the nearest small particles at their centre of mass): four (triangle: three)
  * particles of a level where no criterion would refine their parent any more merge
- * back into one of the next coarser size, conserving mass, momentum and volume. Marked in the same
- * pass (candidates, then groups), applied after the split: combine, scan, compact. */
+ * back into one of the next coarser size, conserving mass, momentum and volume. A candidate
+ * that can be in no group (too few particles of its size near it) is absorbed instead:
+ * shared out among its neighbours of the next coarser size, with the same sums kept.
+ * Marked in the same pass (candidates, groups, absorptions), applied after the split:
+ * combine, scan, compact. */
 #ifndef RHOD_APR_H
 #define RHOD_APR_H
 
@@ -49,11 +52,11 @@ typedef struct {
   long n_marked;  /* fluid particles when marked (coalescing indices are below it) */
   long groups;    /* groups the last marking accepted, for rhod_apr_coalesce */
   long absorbed;  /* stragglers the last marking shared out (marks 5, receivers 6) */
-  long split_last, split_total;   /* particles split by the last call and by the run */
-  long merged_last, merged_total; /* groups coalesced by the last call and by the run */
+  long split_last, split_total;       /* particles split by the last call and by the run */
+  long merged_last, merged_total;     /* groups coalesced by the last call and by the run */
   long absorbed_last, absorbed_total; /* stragglers absorbed by the last call and the run */
-  double ke_merged, ke_absorbed; /* kinetic energy the merges and the absorptions of the run
-                                    took out (motion about the mean), J per unit depth */
+  double ke_merged, ke_absorbed;      /* kinetic energy the merges and the absorptions of the run
+                                         took out (motion about the mean), J per unit depth */
 } rhod_apr;
 
 int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min);
@@ -71,9 +74,10 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
  * (a quarter of their size). Ghosts and cells are stale after it. */
 long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rhod_boundary *b);
 
-/* Merges the groups formed by the last rhod_apr_mark (call it after rhod_apr_split,
- * whose children it keeps) and removes the merged particles; returns the number of
- * groups merged. Ghosts and cells are stale after it. */
+/* Merges the groups formed by the last rhod_apr_mark and the absorbed stragglers into
+ * their receivers (call it after rhod_apr_split, whose children it keeps) and removes
+ * the merged and absorbed particles; returns the number of groups merged. Ghosts and
+ * cells are stale after it. */
 long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p);
 
 #endif

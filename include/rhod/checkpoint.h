@@ -19,11 +19,11 @@ typedef struct {
   /* run state */
   double t, next_out, next_probe, next_checkpoint, checkpoint_every;
   int64_t step, reflected;
-  int64_t splits, merges; /* APR totals of the run so far (0 from a version-1 file) */
-  double stiffness;       /* the stiffness limit's last measure, 1/s (0 before version 3) */
-  int64_t absorbed;       /* APR stragglers absorbed so far (0 before version 4) */
+  int64_t splits, merges;        /* APR totals of the run so far (0 from a version-1 file) */
+  double stiffness;              /* the stiffness limit's last measure, 1/s (0 before version 3) */
+  int64_t absorbed;              /* APR stragglers absorbed so far (0 before version 4) */
   double ke_merged, ke_absorbed; /* the energy coalescing took out so far (idem) */
-  uint64_t probes_bytes;  /* length of probes.csv when the checkpoint was taken */
+  uint64_t probes_bytes;         /* length of probes.csv when the checkpoint was taken */
   int32_t nsnap;
   double *snap_t;
   uint64_t *snap_n;
