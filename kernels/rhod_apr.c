@@ -743,7 +743,6 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   const int32_t *grp = a->grp;
   int32_t *cnt = a->cnt;
   real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *m = p->m, *dx = p->dx;
-  const int nsplit = a->nsplit;
   const real dx_max = a->dx_max, ieps = a->ieps;
   RHOD_KERNEL_LOOP
   for (long i = 0; i <= nm; i++)
@@ -759,39 +758,31 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   real kem = 0, kea = 0;
   RHOD_KERNEL_LOOP_REDUCE2(+, kem, kea)
   for (long i = 0; i < nm; i++) {
-    if (mark[i] == 6) {
-      /* a receiver of absorbed stragglers (absorb above): its shares f_k of them */
-      real M = m[i], X = m[i] * x[i], Y = m[i] * y[i], U = m[i] * ux[i], W = m[i] * uy[i];
-      real V = m[i] / rho[i], K = m[i] * (ux[i] * ux[i] + uy[i] * uy[i]);
-      for (int k = 0; k < 4; k++) {
-        const int32_t j = grp[4 * i + k];
-        const real f = sd[4 * i + k], mj = j >= 0 ? f * m[j] : 0;
-        const int32_t jj = j >= 0 ? j : (int32_t)i;
-        M += mj, X += mj * x[jj], Y += mj * y[jj], U += mj * ux[jj], W += mj * uy[jj];
-        V += mj / rho[jj], K += mj * (ux[jj] * ux[jj] + uy[jj] * uy[jj]);
-      }
-      x[i] = X / M, y[i] = Y / M, ux[i] = U / M, uy[i] = W / M;
-      m[i] = M, rho[i] = M / V;
-      kea += (real)0.5 * (K - (U * U + W * W) / M);
+    const int lead = mark[i] == 3, recv = mark[i] == 6;
+    if (!lead && !recv)
       continue;
-    }
-    if (mark[i] != 3)
-      continue;
-    real M = 0, X = 0, Y = 0, U = 0, W = 0, V = 0, K = 0;
-    for (int k = 0; k < nsplit; k++) {
+    /* a leader's members (itself first, grp[4 i]), each whole; a receiver (absorb
+     * above) itself and its donors' shares f_k */
+    const real mi = recv ? m[i] : 0;
+    real M = mi, X = mi * x[i], Y = mi * y[i], U = mi * ux[i], W = mi * uy[i];
+    real V = recv ? m[i] / rho[i] : 0, K = mi * (ux[i] * ux[i] + uy[i] * uy[i]);
+    for (int k = 0; k < 4; k++) {
       const int32_t j = grp[4 * i + k];
-      const real mj = m[j];
-      M += mj, X += mj * x[j], Y += mj * y[j], U += mj * ux[j], W += mj * uy[j];
-      V += mj / rho[j], K += mj * (ux[j] * ux[j] + uy[j] * uy[j]);
+      const int32_t jj = j >= 0 ? j : (int32_t)i;
+      const real mj = j < 0 ? 0 : (recv ? sd[4 * i + k] : 1) * m[jj];
+      M += mj, X += mj * x[jj], Y += mj * y[jj], U += mj * ux[jj], W += mj * uy[jj];
+      V += mj / rho[jj], K += mj * (ux[jj] * ux[jj] + uy[jj] * uy[jj]);
     }
-    kem += (real)0.5 * (K - (U * U + W * W) / M);
+    const real ke = (real)0.5 * (K - (U * U + W * W) / M);
+    kem += lead ? ke : 0, kea += recv ? ke : 0;
     x[i] = X / M, y[i] = Y / M, ux[i] = U / M, uy[i] = W / M;
-    /* the size one level up, made by the multiplications the splits make from
-     * particles.dx, so that it equals the sizes of that level exactly (2 dx at e = 2) */
+    m[i] = M, rho[i] = M / V;
+    /* a leader takes the size one level up, made by the multiplications the splits make
+     * from particles.dx, so that it equals the sizes of that level exactly (2 dx at e = 2) */
     real D = dx_max;
-    while (D * ieps > dx[i] * (1 + SIZE_TOL))
+    while (lead && D * ieps > dx[i] * (1 + SIZE_TOL))
       D *= ieps;
-    m[i] = M, rho[i] = M / V, dx[i] = D;
+    dx[i] = lead ? D : dx[i];
   }
   const long kept = rhod_scan_exclusive(cnt, (size_t)nm + 1);
   int32_t *perm = p->perm;
