@@ -673,11 +673,11 @@ void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
  * particles, and a branch on a switch is uniform across them). */
 typedef struct {
   real ratio, c0, rho0, ic2, gx, gy, alpha_ad, gth, tth, visc_k, mu;
-  int flags; /* PC_VCONS | PC_TIC | PC_SHSW: one int, since with two GCC 12 nvptx put the
+  int flags; /* PC_VCONS | PC_TIC | PC_SHSW | PC_SHSWC: one int, since with two GCC 12 nvptx put the
                 struct in a lane-shared frame (tests/offload_frames.sh) */
 } pass_c_consts;
 /* the consistent Laplacian; scheme.tensile_control; scheme.shifting_switch */
-enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4 };
+enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4, PC_SHSWC = 8 };
 
 #define PC_PARAMS                                                                                  \
   rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
@@ -814,17 +814,22 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   real dr = riemann ? -2 * rhoi * cont : -rhoi * cont;
   if (shifting) {
     /* Eq. 4: -rho_i <div du> + <div(rho du)> and <div(rho u (x) du)>, sum forms
-     * sum (phi_i + phi_j) grad_i W_ij V_j. With scheme.shifting_switch, where Eq. 6 is
-     * renormalised (the support is full), the difference forms sum (phi_j - phi_i)
-     * grad_i W_ij V_j instead: the sum form carries 2 phi_i sum grad_i W_ij V_j =
-     * 2 phi_i grad Gamma_i, a zeroth-order error wherever grad Gamma_i != 0 inside the
-     * fluid, as at the size jumps of APR (our choice, docs/choices.md "Shifting terms at
-     * size jumps"). The free-surface region keeps the sum forms, as Eq. 6 keeps its
-     * conservative form there. sf = sum grad_i W_ij V_j, so the switch costs nothing in
-     * the loop. */
-    const real dsf = ((K.flags & PC_SHSW) ? renP : 0) * 2 * (dui * sfx + dvi * sfy);
-    dr += -rhoi * ddu + drdu - rhoi * dsf;
-    fx += ruux - rhoi * uxi * dsf, fy += ruuy - rhoi * uyi * dsf;
+     * sum (phi_i + phi_j) grad_i W_ij V_j. The sum form carries 2 phi_i sum grad_i W_ij
+     * V_j = 2 phi_i grad Gamma_i, a zeroth-order error wherever grad Gamma_i != 0 inside
+     * the fluid, as at the size jumps of APR; in the momentum term it is the force
+     * 2 rho_i u_i (du_i . grad Gamma_i), along u_i. With scheme.shifting_switch, where
+     * Eq. 6 is renormalised (the support is full), the momentum term (PC_SHSW:
+     * `momentum` or `true`) and the continuity terms (PC_SHSWC: `true`) take the
+     * difference form sum (phi_j - phi_i) grad_i W_ij V_j instead (our choice,
+     * docs/choices.md "Shifting terms at size jumps": the rotating square needs both for
+     * its angular momentum; with both the four-level dam break gained energy and stopped
+     * at t = 1.52 s, with the momentum term alone it runs to t sqrt(g/H) = 10). The
+     * free-surface region keeps the sum form, as Eq. 6 keeps its conservative form there.
+     * sf = sum grad_i W_ij V_j, so the switch costs nothing in the loop. */
+    const real g2 = renP * 2 * (dui * sfx + dvi * sfy);
+    const real dsm = (K.flags & PC_SHSW) ? g2 : 0, dsc = (K.flags & PC_SHSWC) ? g2 : 0;
+    dr += -rhoi * ddu + drdu - rhoi * dsc;
+    fx += ruux - rhoi * uxi * dsm, fy += ruuy - rhoi * uyi * dsm;
   }
   drho[i] = dr;
   acc[2 * i] = fx / rhoi, acc[2 * i + 1] = fy / rhoi;
@@ -870,7 +875,9 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       .tth = s->theta_th,
       .visc_k = 2 * (RHOD_DIM + 2) * s->mu, /* Eq. 10 */
       .mu = s->mu,
-      .flags = (s->visc_cons ? PC_VCONS : 0) | (s->tic ? PC_TIC : 0) | (s->shsw ? PC_SHSW : 0),
+      .flags = (s->visc_cons ? PC_VCONS : 0) | (s->tic ? PC_TIC : 0) |
+               (s->shsw != RHOD_SHSW_NONE ? PC_SHSW : 0) |
+               (s->shsw == RHOD_SHSW_ALL ? PC_SHSWC : 0),
   };
   const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
             shifting = s->shifting, visc = s->mu != 0;

@@ -101,7 +101,8 @@ typedef struct {
   bool *acoustic_damper;
   double *alpha_ad;
   bool *damper_step_limit;
-  bool *tensile_control, *shifting_switch;
+  bool *tensile_control;
+  int *shifting_switch;
   bool *free_surface;
   double *free_surface_lambda;
   double *shepard_threshold, *theta_threshold;
@@ -248,6 +249,11 @@ static const cyaml_strval_t viscosity_names[] = {
     {"monaghan", RHOD_VISCOSITY_MONAGHAN},
     {"consistent", RHOD_VISCOSITY_CONSISTENT},
 };
+static const cyaml_strval_t shifting_switch_names[] = {
+    {"false", RHOD_SHSW_NONE},
+    {"momentum", RHOD_SHSW_MOMENTUM},
+    {"true", RHOD_SHSW_ALL},
+};
 static const cyaml_strval_t pattern_names[] = {
     {"square", RHOD_PATTERN_SQUARE},
     {"triangle", RHOD_PATTERN_TRIANGLE},
@@ -293,7 +299,7 @@ static const cyaml_schema_field_t f_scheme[] = {
     NUM_OPT("alpha_ad", y_scheme, alpha_ad),
     BOOL_OPT("damper_step_limit", y_scheme, damper_step_limit),
     BOOL_OPT("tensile_control", y_scheme, tensile_control),
-    BOOL_OPT("shifting_switch", y_scheme, shifting_switch),
+    ENUM_OPT("shifting_switch", y_scheme, shifting_switch, shifting_switch_names),
     BOOL_OPT("free_surface", y_scheme, free_surface),
     VEC("free_surface_lambda", OPT, y_scheme, free_surface_lambda),
     NUM_OPT("shepard_threshold", y_scheme, shepard_threshold),
@@ -1406,7 +1412,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->alpha_ad = opt(sc->alpha_ad, 1);
   s->damper_step_limit = opt_bool(sc->damper_step_limit, 1);
   s->tensile_control = opt_bool(sc->tensile_control, 0);
-  s->shifting_switch = opt_bool(sc->shifting_switch, 0);
+  s->shifting_switch =
+      sc->shifting_switch ? (rhod_shifting_switch)*sc->shifting_switch : RHOD_SHSW_NONE;
   s->free_surface = opt_bool(sc->free_surface, 1);
   s->fs_lambda_low = sc->free_surface_lambda ? sc->free_surface_lambda[0] : 0.2;
   s->fs_lambda_high = sc->free_surface_lambda ? sc->free_surface_lambda[1] : 0.75;
@@ -1772,7 +1779,9 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "alpha_ad", s->alpha_ad);
   tb_bool(&t, m, "damper_step_limit", s->damper_step_limit);
   tb_bool(&t, m, "tensile_control", s->tensile_control);
-  tb_bool(&t, m, "shifting_switch", s->shifting_switch);
+  tb_word(&t, m, "shifting_switch",
+          strval_name(shifting_switch_names, CYAML_ARRAY_LEN(shifting_switch_names),
+                      (int)s->shifting_switch));
   tb_bool(&t, m, "free_surface", s->free_surface);
   double lambda[2] = {s->fs_lambda_low, s->fs_lambda_high};
   tb_vec(&t, m, "free_surface_lambda", lambda);

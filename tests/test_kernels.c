@@ -463,12 +463,14 @@ static void test_tensile_control(void) {
 }
 
 /* scheme.shifting_switch (docs/choices.md "Shifting terms at size jumps"): where Eq. 6 is
- * renormalised, the Eq. 4 divergences take the difference form. On a free 20 x 20 patch
- * (jitter 0.2 dx, so grad Gamma != 0 inside), uniform rho and a shear flow u = (s y, 0)
- * that makes U_char, hence du, non-zero: out the right-hand side with shifting on and
- * off, and ren = 1 where Eq. 6 was renormalised. */
+ * renormalised, the Eq. 4 momentum term (`momentum`), or it and the continuity terms
+ * (`true`), take the difference form. On a free 20 x 20 patch
+ * (jitter 0.2 dx, so grad Gamma != 0 inside), uniform rho and a shear flow with a uniform
+ * part, u = (s y, V0), that makes U_char, hence du, non-zero: out the right-hand side with
+ * shifting on and off, and ren = 1 where Eq. 6 was renormalised. */
 enum { SW_N = 20 };
-static void shsw_rhs(int sw, int shifting, double *drho, double *acc, int *ren) {
+static const double SW_V0 = 0.3;
+static void shsw_rhs(int sw, int shifting, double *drho, double *acc, double *u, int *ren) {
   cloud cl;
   const double dx = 0.01;
   cloud_make(&cl, SW_N, SW_N, dx, 0.2, 29);
@@ -477,7 +479,7 @@ static void shsw_rhs(int sw, int shifting, double *drho, double *acc, int *ren) 
   s->shsw = sw;
   s->shifting = shifting;
   for (size_t i = 0; i < p->n; i++)
-    p->ux[i] = (real)(5 * p->y[i]);
+    p->ux[i] = (real)(5 * p->y[i]), p->uy[i] = (real)SW_V0;
   cloud_rhs(&cl);
   rhod_to_host(s->drho, p->n * sizeof(real));
   rhod_to_host(s->acc, 2 * p->n * sizeof(real));
@@ -485,6 +487,7 @@ static void shsw_rhs(int sw, int shifting, double *drho, double *acc, int *ren) 
   rhod_to_host(s->gam, p->n * sizeof(real));
   for (size_t i = 0; i < p->n; i++) {
     drho[i] = s->drho[i], acc[2 * i] = s->acc[2 * i], acc[2 * i + 1] = s->acc[2 * i + 1];
+    u[2 * i] = p->ux[i], u[2 * i + 1] = p->uy[i];
     ren[i] = s->reg[i] == 0 && s->gam[i] >= s->gamma_th;
   }
   cloud_free(&cl);
@@ -492,35 +495,49 @@ static void shsw_rhs(int sw, int shifting, double *drho, double *acc, int *ren) 
 
 static void test_shifting_switch(void) {
   enum { N = SW_N * SW_N };
-  static double d_on[N], d_off[N], d_sw[N], a_on[2 * N], a_off[2 * N], a_sw[2 * N];
+  static double d_on[N], d_off[N], d_sw[N], d_all[N], a_on[2 * N], a_off[2 * N], a_sw[2 * N],
+      a_all[2 * N], u[2 * N];
   static int ren[N];
-  shsw_rhs(0, 0, d_off, a_off, ren);
-  shsw_rhs(0, 1, d_on, a_on, ren);
-  shsw_rhs(1, 1, d_sw, a_sw, ren);
-  /* The shifting part of d rho/dt, -rho <div du> + <div(rho du)>, is du . grad rho = 0
-   * for uniform rho: exactly so in the difference form, while the sum form leaves
-   * 2 rho du . grad Gamma. Outside the renormalised set the switch changes nothing. */
-  double big_sum = 0, big_sw = 0;
-  int nren = 0, same = 1, acc_changed = 0;
+  shsw_rhs(RHOD_SHSW_NONE, 0, d_off, a_off, u, ren);
+  shsw_rhs(RHOD_SHSW_NONE, 1, d_on, a_on, u, ren);
+  shsw_rhs(RHOD_SHSW_MOMENTUM, 1, d_sw, a_sw, u, ren);
+  shsw_rhs(RHOD_SHSW_ALL, 1, d_all, a_all, u, ren);
+  /* For uniform rho the shifting part of d rho/dt, -rho <div du> + <div(rho du)>, is
+   * du . grad rho = 0 in the difference form, while the sum form that the continuity
+   * keeps leaves e_i = 2 rho du_i . grad Gamma_i. The momentum term's sum form carries
+   * the same error times u_i, so the switch must take exactly u_i e_i / rho off rho_i
+   * du_i/dt / rho_i, and change nothing else: not d rho/dt, not the particles outside
+   * the renormalised set. With `true` the continuity terms take the difference form too,
+   * so their shifting part vanishes to round-off, and the momentum term is as above. */
+  const double rho0 = 1000;
+  double big_e = 0, worst = 0, big_all = 0;
+  int nren = 0, same = 1, cont_same = 1, mom_same = 1;
   for (int i = 0; i < N; i++) {
+    cont_same &= d_sw[i] == d_on[i];
+    mom_same &= a_all[2 * i] == a_sw[2 * i] && a_all[2 * i + 1] == a_sw[2 * i + 1];
     if (ren[i]) {
       nren++;
-      big_sum = fmax(big_sum, fabs(d_on[i] - d_off[i]));
-      big_sw = fmax(big_sw, fabs(d_sw[i] - d_off[i]));
-      acc_changed += a_sw[2 * i] != a_on[2 * i] || a_sw[2 * i + 1] != a_on[2 * i + 1];
+      const double e = d_on[i] - d_off[i];
+      big_e = fmax(big_e, fabs(e));
+      big_all = fmax(big_all, fabs(d_all[i] - d_off[i]));
+      for (int k = 0; k < 2; k++)
+        worst = fmax(worst, fabs((a_on[2 * i + k] - a_sw[2 * i + k]) - u[2 * i + k] * e / rho0));
     } else {
       same &=
-          d_sw[i] == d_on[i] && a_sw[2 * i] == a_on[2 * i] && a_sw[2 * i + 1] == a_on[2 * i + 1];
+          a_sw[2 * i] == a_on[2 * i] && a_sw[2 * i + 1] == a_on[2 * i + 1] && d_all[i] == d_on[i];
     }
   }
   CU_ASSERT(nren > 100);
   CU_ASSERT(same);
-  CU_ASSERT(big_sum > 1e-3);                     /* the sum form's 2 rho du . grad Gamma */
-  CU_ASSERT(big_sw < TOL(1e-9, 1e-3) * big_sum); /* round-off */
-  CU_ASSERT(acc_changed > 100);
-  printf("\n  uniform rho: largest shifting part of d rho/dt inside %.3g (sum form), %.3g "
-         "(switched), %d renormalised particles, %d accelerations changed ",
-         big_sum, big_sw, nren, acc_changed);
+  CU_ASSERT(cont_same);
+  CU_ASSERT(big_e > 1e-3); /* the sum form's 2 rho du . grad Gamma */
+  CU_ASSERT(worst < TOL(1e-9, 1e-3) * SW_V0 * big_e / rho0);
+  CU_ASSERT(mom_same);
+  CU_ASSERT(big_all < TOL(1e-9, 1e-3) * big_e); /* round-off */
+  printf("\n  uniform rho: largest sum-form error of d rho/dt inside %.3g (%.3g with `true`), "
+         "switched momentum term off u e / rho by at most %.3g (of %.3g), %d renormalised "
+         "particles ",
+         big_e, big_all, worst, SW_V0 * big_e / rho0, nren);
 }
 
 /* The torque budget (rhod_sph_torque_budget, the torque_budget probe) on a free,
@@ -1110,7 +1127,8 @@ int main(void) {
       {"coincident particles: no pair, finite fields", test_coincident_pair},
       {"tensile control: P_j - P_i where P_i < 0, conservative, off the surface",
        test_tensile_control},
-      {"shifting switch: Eq. 4 difference form where Eq. 6 is renormalised", test_shifting_switch},
+      {"shifting switch: Eq. 4 momentum difference form where Eq. 6 is renormalised",
+       test_shifting_switch},
       {"torque budget: adds up, zero for the conservative forms", test_torque_budget},
       {"PVRS and limiter hand values", test_pvrs_hand_values},
       {"RK4 fourth order, RK2 second order", test_rk_order},

@@ -59,7 +59,7 @@ static void test_full_scene(void) {
   CLOSE(s->alpha_ad, 0.5);
   CU_ASSERT_FALSE(s->damper_step_limit);
   CU_ASSERT_TRUE(s->tensile_control);
-  CU_ASSERT_TRUE(s->shifting_switch);
+  CU_ASSERT_EQUAL(s->shifting_switch, RHOD_SHSW_ALL);
   CU_ASSERT_FALSE(s->free_surface);
   CLOSE(s->fs_lambda_low, 0.25);
   CLOSE(s->fs_lambda_high, 0.7);
@@ -148,7 +148,7 @@ static void test_defaults(void) {
   CU_ASSERT_TRUE(s->damper_step_limit);
   CU_ASSERT_TRUE(s->stiffness_limit);
   CU_ASSERT_FALSE(s->tensile_control);
-  CU_ASSERT_FALSE(s->shifting_switch);
+  CU_ASSERT_EQUAL(s->shifting_switch, RHOD_SHSW_NONE);
   CU_ASSERT_TRUE(s->free_surface);
   CLOSE(s->fs_lambda_low, 0.2);
   CLOSE(s->fs_lambda_high, 0.75);
@@ -332,6 +332,7 @@ static const struct {
     {"refine_surface_band_triangle.yaml", 14, "refinement.surface_band", "must be in [0.5774, 1]"},
     {"refine_surface_band_no_criterion.yaml", 12, "refinement.surface_band", "needs criterion 3"},
     {"refine_pattern_unknown.yaml", 12, "refinement.pattern", "hexagon"},
+    {"shifting_switch_unknown.yaml", 11, "scheme.shifting_switch", "continuity"},
     {"refine_triangle_regions.yaml", 14, "refinement.regions", "need refinement.pattern: square"},
     {"viscosity_unknown.yaml", 12, "scheme.viscosity", "invalid value 'morris'"},
     {"refine_levels_fraction.yaml", 11, "refinement.levels", "whole number"},

@@ -118,6 +118,12 @@ typedef enum {
  * docs/choices.md "Consistent viscous operator"). */
 typedef enum { RHOD_VISCOSITY_MONAGHAN = 0, RHOD_VISCOSITY_CONSISTENT } rhod_viscosity;
 
+/* scheme.shifting_switch: where Eq. 6 is renormalised, which of the Eq. 4 divergences
+ * take the difference form instead of the paper's sum form (docs/choices.md "Shifting
+ * terms at size jumps"): none (false), the momentum term alone (momentum), or the
+ * momentum and continuity terms (true). */
+typedef enum { RHOD_SHSW_NONE = 0, RHOD_SHSW_MOMENTUM, RHOD_SHSW_ALL } rhod_shifting_switch;
+
 /* refinement.pattern: how a particle splits (paper 002 Sec. V A and Appendix, Fig. 32).
  * Square: 1 -> 4, level size ratio e = dx_l / dx_(l+1) = 2 (the paper's pattern);
  * triangle: 1 -> 3, e = sqrt 3 (the Appendix's choice for R/dx = 3). The children have
@@ -165,21 +171,22 @@ typedef struct {
   double mu;         /* physics.mu [Pa s], default 0 (inviscid) */
   double gravity[2]; /* physics.gravity [m/s^2], default [0, 0] */
   /* scheme (paper 002 Sec. IV A; each switch defaults to on): */
-  int riemann;                        /* scheme.riemann: Theta^rho and Theta^u, Eqs. 23-24 */
-  int reconstruction;                 /* scheme.reconstruction: limited linear states Eqs. 13-16
-                                         (off: first order, phi_L = phi_i) */
-  int shifting;                       /* scheme.shifting: Eqs. 25-29 and the Eq. 4 terms */
-  double shift_a, shift_b, shift_eps; /* scheme.shifting_a/b/eps: 0.5, 0.05, 5e-4 (Eq. 27) */
-  int acoustic_damper;                /* scheme.acoustic_damper: Eq. 9 */
-  double alpha_ad;                    /* scheme.alpha_ad: 1 */
-  int damper_step_limit;              /* scheme.damper_step_limit: dt also kept below the
-                                         damper's measured stiffness (rhod_sph.c); default on */
-  int tensile_control;                /* scheme.tensile_control: P_j - P_i in the conservative
-                                        Eq. 6 where P_i < 0, off the free surface (paper 001
-                                        Eq. 5); default off */
-  int shifting_switch;                /* scheme.shifting_switch: the Eq. 4 divergences in the
-                                         difference form where Eq. 6 is renormalised; default
-                                         off (the paper's sum form everywhere) */
+  int riemann;                          /* scheme.riemann: Theta^rho and Theta^u, Eqs. 23-24 */
+  int reconstruction;                   /* scheme.reconstruction: limited linear states Eqs. 13-16
+                                           (off: first order, phi_L = phi_i) */
+  int shifting;                         /* scheme.shifting: Eqs. 25-29 and the Eq. 4 terms */
+  double shift_a, shift_b, shift_eps;   /* scheme.shifting_a/b/eps: 0.5, 0.05, 5e-4 (Eq. 27) */
+  int acoustic_damper;                  /* scheme.acoustic_damper: Eq. 9 */
+  double alpha_ad;                      /* scheme.alpha_ad: 1 */
+  int damper_step_limit;                /* scheme.damper_step_limit: dt also kept below the
+                                           damper's measured stiffness (rhod_sph.c); default on */
+  int tensile_control;                  /* scheme.tensile_control: P_j - P_i in the conservative
+                                          Eq. 6 where P_i < 0, off the free surface (paper 001
+                                          Eq. 5); default off */
+  rhod_shifting_switch shifting_switch; /* scheme.shifting_switch: which Eq. 4 divergences
+                                           take the difference form where Eq. 6 is
+                                           renormalised; default none (the paper's sum form
+                                           everywhere) */
   int free_surface; /* scheme.free_surface: detection of Ref. 51 and the Eq. 6 switch;
                        off: every particle is inner */
   double fs_lambda_low, fs_lambda_high; /* scheme.free_surface_lambda: [0.2, 0.75] */

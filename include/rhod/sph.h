@@ -55,7 +55,7 @@ typedef struct {
   real cfl, cfl_visc;
   int riemann, recon, shifting, damper, fsdetect;
   int tic;       /* scheme.tensile_control */
-  int shsw;      /* scheme.shifting_switch */
+  int shsw;      /* scheme.shifting_switch (rhod_shifting_switch) */
   int adlim;     /* scheme.damper_step_limit (and the damper on) */
   int visc_cons; /* scheme.viscosity: consistent (and mu > 0) */
   int generic;   /* 1: the general copies of the gathers, never the specialised ones
