@@ -504,13 +504,13 @@ PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
   }
   const real *kx = pk + RHOD_PK_FX * st, *ky = pk + RHOD_PK_FY * st, *knx = pk + RHOD_PK_FNX * st,
              *kny = pk + RHOD_PK_FNY * st;
-  const real iR = 1 / Ri;
+  const real iR = 1 / Ri, R2in = R2 * (1 + 2 * RHOD_SUPPORT_TIE); /* kernel.h */
   real RHOD_LANES(ssx), RHOD_LANES(ssy), RHOD_LANES(sd2), RHOD_LANES(sany);
   RHOD_LANES_SET(sd2, R2);
   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
     RHOD_FOR_LANES(k0, kv, k) {
       const real rx = kx[k] - xi, ry = ky[k] - yi, r2 = rx * rx + ry * ry;
-      if (!(r2 < R2))
+      if (!(r2 < R2in))
         continue;
       const real w = rhod_Wq(kern, sqrt(r2) * iR); /* W R^2: nt is normalised below */
       RHOD_LANE(ssx) += w * knx[k], RHOD_LANE(ssy) += w * kny[k];
