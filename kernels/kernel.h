@@ -15,7 +15,7 @@
 
 /* Where a yes-or-no question asks whether a particle lies in another's support of
  * radius R (the free-surface region V, the APR criteria 1 and 3), "in" means r <= R up
- * to rounding: r^2 < R^2 (1 + 2 RHOD_SUPPORT_TIE), the closed support; the same
+ * to rounding: r^2 < R^2 (1 + 2 RHOD_SUPPORT_TIE) (rhod_closed_support2); the same
  * tolerance settles ties between nearest neighbours and split patterns (rhod_apr_mark).
  * Our choice (the paper is silent): on a lattice many pairs stand exactly R apart, and
  * there the rounding of r^2, which differs between mirror images of one pair, decided,
@@ -29,6 +29,9 @@
 #else
 #define RHOD_SUPPORT_TIE ((real)1e-9)
 #endif
+
+/* The bound on r^2 of the closed support of radius R: j is in when r^2 < this. */
+static inline real rhod_closed_support2(real R) { return R * R * (1 + 2 * RHOD_SUPPORT_TIE); }
 
 /* R^2 W as a function of q = r/R (0 for q >= 1). */
 static inline real rhod_Wq(int kind, real q) {

@@ -135,7 +135,7 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
 #define CRITERIA_SUMS(i, R, small, big, same, num, den, anysmall)                                  \
   {                                                                                                \
     const real xs_ = x[i], ys_ = y[i], iR_ = 1 / (R), iR2_ = iR_ * iR_;                            \
-    const real R2_ = (R) * (R) * (1 + 2 * RHOD_SUPPORT_TIE); /* the closed support, kernel.h */    \
+    const real R2_ = rhod_closed_support2(R); /* kernel.h */                                       \
     real RHOD_LANES(ssame_), RHOD_LANES(snum_), RHOD_LANES(sden_), RHOD_LANES(ssmall_);            \
     RHOD_FOR_ROWS(G, CS, xs_, ys_, (R), k0_, k1_, kv_) {                                           \
       RHOD_FOR_LANES(k0_, kv_, k_) {                                                               \
@@ -254,7 +254,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
        * needs the other candidates too (coalesce_c2): the sum of Gamma over sizes >= D
        * is kept in sp. */
       const real RD = eps * Ri, iRD = 1 / RD, iRD2 = iRD * iRD;
-      const real RH = HYST * band * RD, RH2 = RH * RH * (1 + 2 * RHOD_SUPPORT_TIE);
+      const real RH = HYST * band * RD, RH2 = rhod_closed_support2(RH);
       int ok = 1;
       if (c3) {
         RHOD_FOR_NEIGHBOURS(Gf, CSf, CIf, xi, yi, RH, j) {
@@ -286,7 +286,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
      * refines symmetrically; the first where the keys tie too (directions a quarter
      * turn apart, whose squares are the same). The sum of the tied unit vectors
      * instead (also symmetric) took the four-level dam break's P1 from 3.1 % to 6.5 % of
-     * SR 200, this rule 3.8 % (cases/rotating_square/RESULTS.md, "Symmetry"). */
+     * the stored SR 200 run, this rule 3.8 % (cases/rotating_square/RESULTS.md, "Symmetry"). */
     real best = R2, ex = 1, ey = 0, bkey = 2;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;

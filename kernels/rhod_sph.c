@@ -504,7 +504,7 @@ PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
   }
   const real *kx = pk + RHOD_PK_FX * st, *ky = pk + RHOD_PK_FY * st, *knx = pk + RHOD_PK_FNX * st,
              *kny = pk + RHOD_PK_FNY * st;
-  const real iR = 1 / Ri, R2in = R2 * (1 + 2 * RHOD_SUPPORT_TIE); /* kernel.h */
+  const real iR = 1 / Ri, R2in = rhod_closed_support2(Ri); /* kernel.h */
   real RHOD_LANES(ssx), RHOD_LANES(ssy), RHOD_LANES(sd2), RHOD_LANES(sany);
   RHOD_LANES_SET(sd2, R2);
   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {

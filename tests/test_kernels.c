@@ -884,7 +884,7 @@ static void region_check(double jitter, double *worst_sig, double *worst_n, int 
       const double rx = p->x[j] - p->x[i], ry = p->y[j] - p->y[i], r2 = rx * rx + ry * ry;
       /* in the closed support r <= R up to rounding, the rule of kernel.h (a lattice has
        * free-surface particles exactly R away, where rounding would decide) */
-      if (!s->fs[j] || !(r2 < R * R * (1 + 2 * (double)RHOD_SUPPORT_TIE)))
+      if (!s->fs[j] || !(r2 < rhod_closed_support2((real)R)))
         continue;
       const double w = rhod_W(s->kernel, (real)sqrt(r2), (real)R);
       sx += w * s->nrm[2 * j], sy += w * s->nrm[2 * j + 1];
