@@ -639,16 +639,42 @@ static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c)
  * Eq. 27 with U_char dt replaced by a fixed fraction of the particle's size: J = -R grad C
  * makes it a diffusion of the concentration with coefficient RHOD_RELAX_BETA R dx, the
  * step is at most RHOD_RELAX_STEP dx, and the last bound is Eq. 27's own limit on the
- * change of Gamma. Needs the cells and ghosts of the current positions (rhod_sim_prepare);
- * moves the fluid particles only and leaves every other field as it was. */
-void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
+ * change of Gamma. With jumps_dx > 0 (particles.relax_where: jumps, our option) only a
+ * particle within reach of one of another size moves: r_ij <= R of the larger of the two
+ * (the closed support of the yes-or-no tests, kernel.h), sizes apart by more than 1e-3
+ * of dx_i; jumps_dx is the largest size present, which bounds the gather. It reads the
+ * positions from pass A's packed rows, so moving x_i in the same loop races with no
+ * other particle's test. Needs the cells and ghosts of the current positions
+ * (rhod_sim_prepare); moves the fluid particles only and leaves every other field as it
+ * was. */
+void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx) {
   gradients_and_surface(s, p, c);
-  const long n = (long)p->n;
+  const long n = (long)p->n, st = (long)p->cap;
   real *x = p->x, *y = p->y;
   const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *ggam = s->ggam, *dx = p->dx;
-  const real ratio = s->ratio, eps = s->seps;
-  RHOD_KERNEL_LOOP
+  const real *kx = s->pk + RHOD_PK_X * st, *ky = s->pk + RHOD_PK_Y * st;
+  const real *kdx = s->pk + RHOD_PK_DX * st;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start;
+  const real ratio = s->ratio, eps = s->seps, Rg = ratio * jumps_dx;
+  RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
+    if (jumps_dx > 0) {
+      const real xi = x[i], yi = y[i], dxi = dx[i], tol = (real)1e-3 * dxi;
+      real RHOD_LANES(sjump);
+      RHOD_FOR_ROWS(G, CS, xi, yi, Rg, k0, k1, kv) {
+        RHOD_FOR_LANES(k0, kv, k) {
+          const real rx = kx[k] - xi, ry = ky[k] - yi, dxj = kdx[k];
+          const real Rm = ratio * (dxj > dxi ? dxj : dxi);
+          const int other = fabs(dxj - dxi) > tol && rx * rx + ry * ry < rhod_closed_support2(Rm);
+          RHOD_LANE(sjump) = other ? 1 : RHOD_LANE(sjump);
+        }
+        RHOD_END_LANES
+      }
+      RHOD_END_ROWS
+      if (!(RHOD_LANES_MAX(sjump) > 0))
+        continue;
+    }
     SHIFT_J(i, Jx, Jy);
     const real jm = sqrt(Jx * Jx + Jy * Jy);
     if (!(jm > 0))

@@ -86,6 +86,7 @@ typedef struct {
   int *kernel;
   double *jitter;
   double *relax;
+  int *relax_where;
 } y_particles;
 
 typedef struct {
@@ -254,6 +255,10 @@ static const cyaml_strval_t shifting_switch_names[] = {
     {"momentum", RHOD_SHSW_MOMENTUM},
     {"true", RHOD_SHSW_ALL},
 };
+static const cyaml_strval_t relax_where_names[] = {
+    {"all", RHOD_RELAX_ALL},
+    {"jumps", RHOD_RELAX_JUMPS},
+};
 static const cyaml_strval_t pattern_names[] = {
     {"square", RHOD_PATTERN_SQUARE},
     {"triangle", RHOD_PATTERN_TRIANGLE},
@@ -279,6 +284,7 @@ static const cyaml_schema_field_t f_particles[] = {
     NUM_OPT("radius_ratio", y_particles, radius_ratio),
     NUM_OPT("jitter", y_particles, jitter),
     NUM_OPT("relax", y_particles, relax),
+    ENUM_OPT("relax_where", y_particles, relax_where, relax_where_names),
     ENUM_OPT("kernel", y_particles, kernel, kernel_names),
     CYAML_FIELD_END,
 };
@@ -1387,6 +1393,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     return fail(c, "particles.relax", "must be a whole number in [0, %d], got %g", RHOD_RELAX_MAX,
                 relax);
   s->relax = (int)relax;
+  s->relax_where =
+      d->particles.relax_where ? (rhod_relax_where)*d->particles.relax_where : RHOD_RELAX_ALL;
   /* physics */
   s->rho0 = opt(d->physics.rho0, 1000);
   s->c0 = d->physics.c0;
@@ -1761,6 +1769,10 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "jitter", s->jitter);
   if (s->relax > 0) /* absent at 0, so checkpoints made before the key resume */
     tb_num(&t, m, "relax", s->relax);
+  if (s->relax_where != RHOD_RELAX_ALL) /* likewise absent at its default */
+    tb_word(
+        &t, m, "relax_where",
+        strval_name(relax_where_names, CYAML_ARRAY_LEN(relax_where_names), (int)s->relax_where));
   tb_word(&t, m, "kernel",
           strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
   m = tb_coll(&t, root, "physics", RY_MAP, 0);

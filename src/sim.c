@@ -282,9 +282,14 @@ static int relax_initial(rhod_sim *s) {
     return RHOD_ERR_MEMORY;
   for (size_t k = 0; k < p->n; k++)
     blk[p->id[k]] = fluid_block_at(s, p->x[k], p->y[k]);
+  /* particles.relax_where: jumps: the largest size present bounds the test's gather */
+  real jumps_dx = 0;
+  if (s->sc->relax_where == RHOD_RELAX_JUMPS)
+    for (size_t k = 0; k < p->n; k++)
+      jumps_dx = p->dx[k] > jumps_dx ? p->dx[k] : jumps_dx;
   int st = RHOD_OK;
   for (int it = 0; it < s->sc->relax && st == RHOD_OK; it++) {
-    rhod_sph_relax(&s->sph, p, &s->cells);
+    rhod_sph_relax(&s->sph, p, &s->cells, jumps_dx);
     rhod_walls_guard(&s->bnd, p);
     st = rhod_sim_prepare(s, 1);
   }

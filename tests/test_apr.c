@@ -1351,6 +1351,64 @@ static void test_initial_relaxation(void) {
   CU_ASSERT(top[1] < top[0] + 0.001); /* the surface stays: at most 0.1 dx higher */
 }
 
+/* particles.relax_where: jumps. The jittered two-level tank of the test above, unrelaxed,
+ * relaxed everywhere and relaxed at the size jumps only (20 iterations each): at the
+ * jumps only, no particle farther than R of the larger size plus the farthest the
+ * iterations can carry two particles (2 x 20 x 0.1 dx) from every particle of another
+ * size moves at all (the lattice stays bit for bit there), while most of those within
+ * R of another size do move; relaxed everywhere, the far ones move too (so the test sees
+ * the option). Fails with the jump test dropped (every particle moves) or inverted. */
+static void test_relax_at_jumps(void) {
+  const char *where[3] = {"all", "all", "jumps"};
+  const int iters[3] = {0, 20, 20};
+  enum { MAXID = 4096 };
+  static double x0[MAXID], y0[MAXID], dist[MAXID];
+  long far_moved[3] = {0}, near_moved[3] = {0}, far = 0, near = 0;
+  for (int k = 0; k < 3; k++) {
+    char yaml[1024], tag[32];
+    snprintf(yaml, sizeof yaml,
+             REST_TANK_P("{dx: 0.01, jitter: 0.3, relax: %d, relax_where: %s}",
+                         "  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n"),
+             iters[k], where[k]);
+    snprintf(tag, sizeof tag, "relaxjump%d", k);
+    run r;
+    CU_ASSERT_FATAL(run_open(&r, tag, yaml));
+    rhod_snapshot_view v;
+    rhod_sim_fetch(r.sim, &v);
+    if (k == 0) {
+      /* each particle's distance to the nearest of another size, over R of the larger */
+      for (size_t i = 0; i < v.n; i++) {
+        CU_ASSERT_FATAL(v.id[i] < MAXID);
+        double best = 1e30;
+        for (size_t j = 0; j < v.n; j++)
+          if (fabs(v.size[j] - v.size[i]) > 1e-3 * v.size[i]) {
+            const double d = hypot(v.x[j] - v.x[i], v.y[j] - v.y[i]);
+            const double R = 4 * (v.size[j] > v.size[i] ? v.size[j] : v.size[i]);
+            best = d - R < best ? d - R : best;
+          }
+        x0[v.id[i]] = v.x[i], y0[v.id[i]] = v.y[i], dist[v.id[i]] = best;
+        far += best > 2 * 20 * 0.1 * 0.01;
+        near += best <= 0;
+      }
+    } else {
+      for (size_t i = 0; i < v.n; i++) {
+        const uint64_t id = v.id[i];
+        const int moved = v.x[i] != x0[id] || v.y[i] != y0[id];
+        far_moved[k] += moved && dist[id] > 2 * 20 * 0.1 * 0.01;
+        near_moved[k] += moved && dist[id] <= 0;
+      }
+    }
+    run_close(&r);
+  }
+  printf("\n  %ld particles within R of another size, %ld beyond reach; moved (all / jumps): "
+         "%ld / %ld and %ld / %ld ",
+         near, far, near_moved[1], near_moved[2], far_moved[1], far_moved[2]);
+  CU_ASSERT(near > 50 && far > 20);
+  CU_ASSERT_EQUAL(far_moved[2], 0);
+  CU_ASSERT(near_moved[2] > near / 2);
+  CU_ASSERT(far_moved[1] > far / 2);
+}
+
 /* A collapsing column with the triangle (three levels: dx, dx/sqrt 3, dx/3), criterion 3
  * and coalescing: every size is one of the three level sizes exactly (as the splits and
  * the merges make them), both finer levels are present, every split during the run adds
@@ -1660,6 +1718,7 @@ int main(void) {
       {"coalescing: criterion 3 within 1.25 times the merged support, exactly", test_coalesce_band},
       {"a run with the triangle: level sizes, splits and merges", test_triangle_run},
       {"initial relaxation: grad C falls, surface and state kept", test_initial_relaxation},
+      {"relaxation at the size jumps only: the lattice elsewhere kept", test_relax_at_jumps},
       {"a hand-made scene without levels is refused", test_levels_guard},
       {"snapshot free-surface flags, across levels and splits", test_free_surface_flags},
       {"levels 2 without splits = single resolution", test_equal_sizes_single_resolution},

@@ -118,6 +118,11 @@ typedef enum {
  * docs/choices.md "Consistent viscous operator"). */
 typedef enum { RHOD_VISCOSITY_MONAGHAN = 0, RHOD_VISCOSITY_CONSISTENT } rhod_viscosity;
 
+/* particles.relax_where: which particles the initial relaxation moves: all of them, or
+ * only those within reach of a particle of another size (r <= R of the larger of the
+ * two), so that a lattice start keeps its lattice away from the size jumps. */
+typedef enum { RHOD_RELAX_ALL = 0, RHOD_RELAX_JUMPS } rhod_relax_where;
+
 /* scheme.shifting_switch: where Eq. 6 is renormalised, which of the Eq. 4 divergences
  * take the difference form instead of the paper's sum form (docs/choices.md "Shifting
  * terms at size jumps"): none (false), the momentum term alone (momentum), or the
@@ -165,6 +170,8 @@ typedef struct {
                               a fraction of dx in [0, 0.5], default 0 */
   int relax;               /* particles.relax: iterations of the initial relaxation by the
                               shifting operator (before t = 0), default 0 */
+  /* particles.relax_where, default all */
+  rhod_relax_where relax_where;
   /* physics: */
   double rho0;       /* physics.rho0 [kg/m^3], default 1000 */
   double c0;         /* physics.c0 [m/s] (required), Eq. 2 */

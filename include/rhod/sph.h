@@ -113,8 +113,10 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c);
 void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt);
 void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 /* One iteration of the initial relaxation (particles.relax): moves the fluid particles
- * along the shifting direction J of Eqs. 25-26; cells and ghosts must be current. */
-void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c);
+ * along the shifting direction J of Eqs. 25-26; cells and ghosts must be current. With
+ * jumps_dx > 0 (the largest size present; particles.relax_where: jumps) only those within
+ * reach of a particle of another size move. */
+void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx);
 
 /* Target of the measured step limits: dt |lambda| of Eq. 9 (the damper step limit) and
  * dt times the stiffness of the RK4 stages (the stiffness limit) kept at or below this,
