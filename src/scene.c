@@ -1395,6 +1395,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   s->relax = (int)relax;
   s->relax_where =
       d->particles.relax_where ? (rhod_relax_where)*d->particles.relax_where : RHOD_RELAX_ALL;
+  if (d->particles.relax_where && s->relax == 0)
+    return fail(c, "particles.relax_where", "needs particles.relax (iterations) above 0");
   /* physics */
   s->rho0 = opt(d->physics.rho0, 1000);
   s->c0 = d->physics.c0;

@@ -339,6 +339,7 @@ static const struct {
     {"refine_levels_zero.yaml", 11, "refinement.levels", "whole number"},
     {"relax_fraction.yaml", 6, "particles.relax", "whole number"},
     {"relax_where_unknown.yaml", 7, "particles.relax_where", "surface"},
+    {"relax_where_no_relax.yaml", 6, "particles.relax_where", "needs particles.relax"},
     {"refine_region_level.yaml", 14, "refinement.regions.0.level", "whole number"},
     {"refine_region_no_shape.yaml", 13, "refinement.regions.0", "needs a shape"},
     {"duplicate_key.yaml", 6, "particles.dx", "duplicate key"},
