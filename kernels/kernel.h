@@ -30,6 +30,10 @@
 #define RHOD_SUPPORT_TIE ((real)1e-9)
 #endif
 
+/* Relative tolerance when comparing particle sizes (APR criteria, coalescing, the
+ * relaxation at size jumps): sizes are dx / e^l, equal up to rounding. */
+#define RHOD_SIZE_TOL ((real)1e-3)
+
 /* The bound on r^2 of the closed support of radius R: j is in when r^2 < this. */
 static inline real rhod_closed_support2(real R) { return R * R * (1 + 2 * RHOD_SUPPORT_TIE); }
 

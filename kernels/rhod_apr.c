@@ -9,9 +9,6 @@
 #include <math.h>
 #include <string.h>
 
-/* Relative tolerance when comparing sizes: sizes are dx / e^l, equal up to rounding. */
-#define SIZE_TOL ((real)1e-3)
-
 /* Coalescing (our choices, docs/choices.md "APR coalescing"). A particle of size dx_i
  * is a candidate when the particle of size e dx_i that its group would become would
  * not be refined again: criteria 1, 2 and 5 evaluated for the support of radius
@@ -201,7 +198,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   uint8_t *mark = a->mark;
   real *sd = a->sd, *sp = a->sp;
   const int kern = s->kernel;
-  const real ratio = s->ratio, dmin = a->dx_min * (1 - SIZE_TOL);
+  const real ratio = s->ratio, dmin = a->dx_min * (1 - RHOD_SIZE_TOL);
   const real eps = a->eps, ieps = a->ieps, nsplit = (real)a->nsplit;
   const int tri = a->nsplit == 3;
   const int c3 = a->free_surface && s->fsdetect, c4 = a->walls;
@@ -214,7 +211,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real above = a->above, below = a->below;
   /* coalescing: the largest size that may merge, the thresholds of criterion 5 with
    * the margin (HYST - 1) |threshold| (1e30 stands for none and stays far away) */
-  const real dgrow = ieps * a->dx_max * (1 + SIZE_TOL);
+  const real dgrow = ieps * a->dx_max * (1 + RHOD_SIZE_TOL);
   const real above2 = above - (HYST - 1) * fabs(above), below2 = below + (HYST - 1) * fabs(below);
   /* a gather loop (its work per particle varies: the candidates and marked particles
    * gather, the rest stop early); the candidates are counted after it, so that the count
@@ -233,7 +230,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     const real self = rhod_Wq(kern, 0) * iR2 * V[i]; /* Gamma_ii, Eq. 7 */
     const real phii = field_of(dyn, rho[i], ux[i], uy[i], P[i]);
     /* criterion 1: a neighbour two levels finer, dx_i / e^2 (dx_i / 4 at e = 2) */
-    const real quarter = dxi * ieps * ieps * (1 + SIZE_TOL), lower = dxi * (1 - SIZE_TOL);
+    const real quarter = dxi * ieps * ieps * (1 + RHOD_SIZE_TOL), lower = dxi * (1 - RHOD_SIZE_TOL);
     real same = self; /* criterion 2: sum of Gamma_ij over dx_j >= dx_i, i included */
     real num = self * phii, den = self; /* criterion 5: Shepard average, i included */
     int grand = 0;                      /* criterion 1 */
@@ -265,7 +262,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
       }
       if (ok) {
         const real self2 = rhod_Wq(kern, 0) * iRD2 * nsplit * V[i];
-        const real half = ieps * dxi * (1 + SIZE_TOL), big = eps * dxi * (1 - SIZE_TOL);
+        const real half = ieps * dxi * (1 + RHOD_SIZE_TOL), big = eps * dxi * (1 - RHOD_SIZE_TOL);
         real same2 = 0, num2 = self2 * phii, den2 = self2;
         int fine = 0;
         CRITERIA_SUMS(i, RD, half, big, same2, num2, den2, fine);
@@ -407,7 +404,7 @@ static long coalesce_c2(rhod_apr *a, const rhod_sph *s, const rhod_particles *p,
       continue;
     const real xi = x[i], yi = y[i], dxi = dx[i], RD = eps * ratio * dxi, RD2 = RD * RD;
     const real iRD = 1 / RD, iRD2 = iRD * iRD, self2 = rhod_Wq(kern, 0) * iRD2 * nsplit * V[i];
-    const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
+    const real lo = dxi * (1 - RHOD_SIZE_TOL), hi = dxi * (1 + RHOD_SIZE_TOL);
     real sum = sp[i];
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, RD, j) {
       const real rx = x[j] - xi, ry = y[j] - yi, r2 = rx * rx + ry * ry;
@@ -461,7 +458,7 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
     if (mark[i] != 2)
       continue;
     const real xi = x[i], yi = y[i], dxi = dx[i], reach = 2 * dxi, reach2 = reach * reach;
-    const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
+    const real lo = dxi * (1 - RHOD_SIZE_TOL), hi = dxi * (1 + RHOD_SIZE_TOL);
     int32_t g1 = -1, g2 = -1, g3 = -1;
     real cx = xi, cy = yi;
     for (int r = 0; r < others; r++) {
@@ -518,7 +515,7 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
     claim[j] = -1;
     if (mark[j] != 2)
       continue;
-    const real reach = 2 * dx[j] * (1 + SIZE_TOL);
+    const real reach = 2 * dx[j] * (1 + RHOD_SIZE_TOL);
     real bs = NONE;
     int32_t bi = -1;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, x[j], y[j], reach, i) {
@@ -603,7 +600,7 @@ static long absorb(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, cons
     if (mark[i] != 2)
       continue;
     const real xi = x[i], yi = y[i], dxi = dx[i], reach = 2 * dxi, reach2 = reach * reach;
-    const real lo = dxi * (1 - SIZE_TOL), hi = dxi * (1 + SIZE_TOL);
+    const real lo = dxi * (1 - RHOD_SIZE_TOL), hi = dxi * (1 + RHOD_SIZE_TOL);
     int same = 0;
     RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, reach, j) {
       const real rx = x[j] - xi, ry = y[j] - yi;
@@ -621,7 +618,7 @@ static long absorb(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, cons
     if (!(mark[j] == 0 || mark[j] == 2) || acc[j] || m[j] >= ABSORB_VMAX * rho[j] * dxj * dxj)
       continue;
     const real xj = x[j], yj = y[j], dd = dxj * ieps; /* the donors' size */
-    const real lo = dd * (1 - SIZE_TOL), hi = dd * (1 + SIZE_TOL), Ra = (1 + eps) * dd;
+    const real lo = dd * (1 - RHOD_SIZE_TOL), hi = dd * (1 + RHOD_SIZE_TOL), Ra = (1 + eps) * dd;
     const real Ra2 = Ra * Ra;
     real d0 = NONE, d1 = NONE, d2 = NONE, d3 = NONE;
     int32_t j0 = -1, j1 = -1, j2 = -1, j3 = -1;
@@ -797,7 +794,7 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
     /* a leader takes the size one level up, made by the multiplications the splits make
      * from particles.dx, so that it equals the sizes of that level exactly (2 dx at e = 2) */
     real D = dx_max;
-    while (lead && D * ieps > dx[i] * (1 + SIZE_TOL))
+    while (lead && D * ieps > dx[i] * (1 + RHOD_SIZE_TOL))
       D *= ieps;
     dx[i] = lead ? D : dx[i];
   }

@@ -641,8 +641,8 @@ static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c)
  * step is at most RHOD_RELAX_STEP dx, and the last bound is Eq. 27's own limit on the
  * change of Gamma. With jumps_dx > 0 (particles.relax_where: jumps, our option) only a
  * particle within reach of one of another size moves: r_ij <= R of the larger of the two
- * (the closed support of the yes-or-no tests, kernel.h), sizes apart by more than 1e-3
- * of dx_i; jumps_dx is the largest size present, which bounds the gather. It reads the
+ * (the closed support of the yes-or-no tests, kernel.h), sizes apart by more than
+ * RHOD_SIZE_TOL dx_i; jumps_dx is the largest size present, which bounds the gather. It reads the
  * positions from pass A's packed rows, so moving x_i in the same loop races with no
  * other particle's test. Needs the cells and ghosts of the current positions
  * (rhod_sim_prepare); moves the fluid particles only and leaves every other field as it
@@ -660,7 +660,7 @@ void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
     if (jumps_dx > 0) {
-      const real xi = x[i], yi = y[i], dxi = dx[i], tol = (real)1e-3 * dxi;
+      const real xi = x[i], yi = y[i], dxi = dx[i], tol = RHOD_SIZE_TOL * dxi;
       real RHOD_LANES(sjump);
       RHOD_FOR_ROWS(G, CS, xi, yi, Rg, k0, k1, kv) {
         RHOD_FOR_LANES(k0, kv, k) {
