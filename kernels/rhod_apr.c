@@ -22,7 +22,9 @@
  * than dx_i from the centre of mass (a 2 x 2 block of a lattice: 0.71 dx_i) and no
  * other particle j comes nearer to that centre than Q_MIN (e dx_i + dx_j)/2, the spacing
  * of the merged particle and j on a regular layout (0.5 of it, which is where the
- * children of a split stand on a regular lattice too). */
+ * children of a split stand on a regular lattice too); a j finer than the merged
+ * particle no nearer than refinement.crowding of it either, when that is more, or the
+ * merged particle would split again at once. */
 #define Q_MIN ((real)0.5)
 #define NONE ((real)1e30)
 
@@ -64,6 +66,7 @@ int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   a->dx_min = (real)dx_min;
   a->free_surface = sc->refine_free_surface;
   a->band = (real)sc->refine_band;
+  a->crowd = (real)sc->refine_crowding;
   a->walls = sc->refine_walls;
   a->field = sc->refine_field;
   a->qty = sc->field_quantity;
@@ -121,7 +124,8 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
 /* Sums of the criteria over the neighbours j within R of particle i (r_ij > 0, which
  * leaves i out), added to the variables named (which hold the self terms): Gamma_ij =
  * W(r_ij; R) V_j over sizes >= big into same (criterion 2), any size <= small into
- * anysmall (criterion 1), and the Shepard sums of the criterion-5 field into num, den
+ * anysmall (criterion 1), any size below own nearer than ck (own + dx_j)/2 into crowded
+ * (refinement.crowding, ck = 0: never), and the Shepard sums of the criterion-5 field into num, den
  * (computed always, used only with c5: a branch would keep the loop from vectorising).
  * One text for a particle's own support and for the support e R_i of the particle its
  * coalescing group would make. Reads the rows the last right-hand side packed in cell
@@ -129,11 +133,12 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
  * A macro over the marking loop's locals (G, CS, x, y, kx, ky, kV, kdx, kP, kux, kuy,
  * krho, kern, dyn), not a function: GCC 12 nvptx puts a returned struct, like pointer
  * outputs, in the warp-shared frame (tests/offload_frames.sh). */
-#define CRITERIA_SUMS(i, R, small, big, same, num, den, anysmall)                                  \
+#define CRITERIA_SUMS(i, R, small, big, own, ck, same, num, den, anysmall, crowded)                \
   {                                                                                                \
     const real xs_ = x[i], ys_ = y[i], iR_ = 1 / (R), iR2_ = iR_ * iR_;                            \
     const real R2_ = rhod_closed_support2(R); /* kernel.h */                                       \
     real RHOD_LANES(ssame_), RHOD_LANES(snum_), RHOD_LANES(sden_), RHOD_LANES(ssmall_);            \
+    real RHOD_LANES(scrowd_);                                                                      \
     RHOD_FOR_ROWS(G, CS, xs_, ys_, (R), k0_, k1_, kv_) {                                           \
       RHOD_FOR_LANES(k0_, kv_, k_) {                                                               \
         const real rx_ = kx[k_] - xs_, ry_ = ky[k_] - ys_, r2_ = rx_ * rx_ + ry_ * ry_;            \
@@ -141,6 +146,9 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
           continue;                                                                                \
         const real dxj_ = kdx[k_];                                                                 \
         RHOD_LANE(ssmall_) = dxj_ <= (small) ? 1 : RHOD_LANE(ssmall_);                             \
+        const real dc_ = (ck) * (real)0.5 * ((own) + dxj_);                                        \
+        const int cr_ = dxj_ < (own) * (1 - RHOD_SIZE_TOL) && r2_ < dc_ * dc_;                     \
+        RHOD_LANE(scrowd_) = cr_ ? 1 : RHOD_LANE(scrowd_);                                         \
         const real w_ = rhod_Wq(kern, sqrt(r2_) * iR_) * iR2_ * kV[k_];                            \
         RHOD_LANE(ssame_) += dxj_ >= (big) ? w_ : 0;                                               \
         const real phij_ = field_of(dyn, krho[k_], kux[k_], kuy[k_], kP[k_]);                      \
@@ -151,8 +159,10 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
     RHOD_END_ROWS                                                                                  \
     const real same_ = RHOD_LANES_SUM(ssame_), num_ = RHOD_LANES_SUM(snum_);                       \
     const real den_ = RHOD_LANES_SUM(sden_), small_ = RHOD_LANES_MAX(ssmall_);                     \
+    const real crowd_ = RHOD_LANES_MAX(scrowd_);                                                   \
     (same) += same_, (num) += num_, (den) += den_;                                                 \
     (anysmall) |= small_ > 0;                                                                      \
+    (crowded) |= crowd_ > 0;                                                                       \
   }
 
 /* Candidates not grouped go back to no mark. */
@@ -207,6 +217,13 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
    * from the paper; docs/choices.md "criterion 3's reach"): i in F, or a free-surface
    * particle nearer than f R_i, read from sigma_i = 1 - d_i/R_i on V (region pass) */
   const real band = a->band, sband = 1 - a->band;
+  /* ours (refinement.crowding, docs/choices.md "crowding at size jumps"): split i when a
+   * finer particle j stands nearer than crowd (dx_i + dx_j)/2, i.e. inside i's share of
+   * the plane (about 1 where the sizes tile it). Such a pair is where APR case B's
+   * pressure bursts start: a child of a split in a squeezed lattice next to an unsplit
+   * coarse neighbour (cases/rotating_square/RESULTS.md, "Bursts at the size jumps");
+   * splitting the coarse one leaves pairs of one size, which single resolution bears. */
+  const real crowd = a->crowd;
   const int c5 = a->field && (real)t >= a->from, dyn = a->qty == RHOD_QTY_DYNAMIC_PRESSURE;
   const real above = a->above, below = a->below;
   /* coalescing: the largest size that may merge, the thresholds of criterion 5 with
@@ -234,11 +251,12 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     real same = self; /* criterion 2: sum of Gamma_ij over dx_j >= dx_i, i included */
     real num = self * phii, den = self; /* criterion 5: Shepard average, i included */
     int grand = 0;                      /* criterion 1 */
+    int crowded = 0;                    /* refinement.crowding */
     if (can_split) /* a particle at dx_min is here only as a coalescing candidate */
-      CRITERIA_SUMS(i, Ri, quarter, lower, same, num, den, grand);
+      CRITERIA_SUMS(i, Ri, quarter, lower, dxi, crowd, same, num, den, grand, crowded);
     const real phi = num / den;
     const int in3 = c3 && (reg[i] == 2 || (reg[i] == 1 && (band >= 1 || sig[i] > sband)));
-    const int m = can_split && (grand || same < 2 * self || in3 || (c4 && near[i]) ||
+    const int m = can_split && (grand || crowded || same < 2 * self || in3 || (c4 && near[i]) ||
                                 (c5 && (phi > above || phi < below)));
     mark[i] = (uint8_t)m;
     if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i])) {
@@ -265,7 +283,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
         const real half = ieps * dxi * (1 + RHOD_SIZE_TOL), big = eps * dxi * (1 - RHOD_SIZE_TOL);
         real same2 = 0, num2 = self2 * phii, den2 = self2;
         int fine = 0;
-        CRITERIA_SUMS(i, RD, half, big, same2, num2, den2, fine);
+        /* crowding: the group's room test (group_round), which knows its members */
+        CRITERIA_SUMS(i, RD, half, big, dxi, 0, same2, num2, den2, fine, fine);
         const real phi2 = num2 / den2;
         ok = !fine && !(c5 && (phi2 > above2 || phi2 < below2));
         sp[i] = same2;
@@ -451,6 +470,7 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
   int32_t *grp = a->grp, *claim = a->claim;
   real *sp = a->sp;
   const real eps = a->eps;
+  const real qcrowd = a->crowd > Q_MIN ? a->crowd : Q_MIN;
   const int others = a->nsplit - 1; /* members besides the candidate: 3 or 2 */
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
@@ -496,10 +516,13 @@ static long group_round(rhod_apr *a, const rhod_particles *p, const rhod_cells *
       continue;
     /* room around the merged particle (ghosts included, so walls count) */
     int room = 1;
-    const real look = 3 * dxi;
+    const real look = 3 * dxi, D = eps * dxi * (1 - RHOD_SIZE_TOL);
     RHOD_FOR_NEIGHBOURS(G, CS, CI, X, Y, look, j) {
       if (j != i && j != g1 && j != g2 && j != g3) {
-        const real rx = x[j] - X, ry = y[j] - Y, q = Q_MIN * ((real)0.5 * (eps * dxi + dx[j]));
+        /* a finer j nearer than refinement.crowding allows would split the merged
+         * particle again at once */
+        const real qj = dx[j] < D ? qcrowd : Q_MIN;
+        const real rx = x[j] - X, ry = y[j] - Y, q = qj * ((real)0.5 * (eps * dxi + dx[j]));
         room &= rx * rx + ry * ry >= q * q;
       }
     }

@@ -162,7 +162,7 @@ typedef struct {
   y_region *regions;
   unsigned n_regions;
   bool *dynamic, *free_surface, *walls, *coalesce;
-  double *surface_band;
+  double *surface_band, *crowding;
   int *pattern;
   y_refine_field *field;
 } y_refinement;
@@ -454,6 +454,7 @@ static const cyaml_schema_field_t f_refinement[] = {
     BOOL_OPT("dynamic", y_refinement, dynamic),
     BOOL_OPT("free_surface", y_refinement, free_surface),
     NUM_OPT("surface_band", y_refinement, surface_band),
+    NUM_OPT("crowding", y_refinement, crowding),
     BOOL_OPT("walls", y_refinement, walls),
     BOOL_OPT("coalesce", y_refinement, coalesce),
     CYAML_FIELD_MAPPING_PTR("field", OPT | CYAML_FLAG_FLOW, y_refinement, field, f_refine_field),
@@ -1315,6 +1316,14 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
                 band_min, s->refine_band);
   if (r && r->surface_band && !s->refine_free_surface)
     return fail(c, "refinement.surface_band", "needs criterion 3 (refinement.free_surface: true)");
+  /* our criterion against a finer particle inside a coarser one's share of the plane
+   * (docs/choices.md "crowding at size jumps"): a fraction of the mean of the two sizes */
+  s->refine_crowding = opt(r ? r->crowding : NULL, RHOD_CROWDING_DEFAULT);
+  if (!(s->refine_crowding >= 0 && s->refine_crowding < 1))
+    return fail(c, "refinement.crowding",
+                "must be in [0, 1) (a fraction of the mean of the two particles' sizes; 0: "
+                "off), got %g",
+                s->refine_crowding);
   s->refine_walls = opt_bool(r ? r->walls : NULL, 0);
   s->refine_coalesce = opt_bool(r ? r->coalesce : NULL, 0);
   if (r && r->n_regions && s->pattern != RHOD_PATTERN_SQUARE)
@@ -1870,6 +1879,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_bool(&t, m, "free_surface", s->refine_free_surface);
   if (s->refine_free_surface)
     tb_num(&t, m, "surface_band", s->refine_band);
+  tb_num(&t, m, "crowding", s->refine_crowding);
   tb_bool(&t, m, "walls", s->refine_walls);
   tb_bool(&t, m, "coalesce", s->refine_coalesce);
   if (s->refine_field) {

@@ -449,6 +449,67 @@ static void test_surface_band(void) {
   CU_ASSERT(m6 > 20 && m1 > m6 + 20); /* the jittered surface: 95 against 66 */
 }
 
+/* refinement.crowding against a direct search: a jittered tank with two fixed sizes
+ * (three stripes of the finer one, no t = 0 split). The particles marked with crowding k and not
+ * with crowding 0 must be exactly the coarse ones with a finer particle nearer than k (dx_i +
+ * dx_j)/2 that crowding 0 leaves unmarked, counted away from the walls (whose ghosts the direct
+ * search leaves out). Returns how many crowding added; *wrong counts disagreements. */
+static long crowd_marks(double k, long *wrong) {
+  run r0, r1;
+  char yaml[1024];
+  const char *fmt =
+      REST_TANK_P("{dx: 0.01, jitter: 0.5}",
+                  "  dynamic: false\n"
+                  "  regions: [{rect: {min: [0.04, 0], max: [0.08, 0.12]}, level: 1},\n"
+                  "            {rect: {min: [0.12, 0], max: [0.16, 0.12]}, level: 1},\n"
+                  "            {rect: {min: [0.20, 0], max: [0.24, 0.12]}, level: 1}]\n"
+                  "  crowding: %g\n");
+  snprintf(yaml, sizeof yaml, fmt, 0.0);
+  CU_ASSERT_FATAL(run_open(&r0, "crowd0", yaml));
+  snprintf(yaml, sizeof yaml, fmt, k);
+  CU_ASSERT_FATAL(run_open(&r1, "crowd1", yaml));
+  run *rs[2] = {&r0, &r1};
+  for (int q = 0; q < 2; q++) {
+    rhod_sim *s = rs[q]->sim;
+    rhod_sph_rhs(&s->sph, &s->p, &s->cells, (real)s->dt);
+    CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(&s->apr, &s->sph, &s->p, &s->cells, &s->bnd, 0, 0),
+                          RHOD_OK);
+    rhod_to_host(s->apr.mark, s->p.n);
+  }
+  rhod_snapshot_view v;
+  rhod_sim_fetch(r1.sim, &v); /* the same start in both: the lattice and its jitter */
+  const uint8_t *m0 = r0.sim->apr.mark, *m1 = r1.sim->apr.mark;
+  long added = 0;
+  *wrong = 0;
+  for (size_t i = 0; i < v.n; i++) {
+    const real Ri = r1.sim->sph.ratio * v.size[i];
+    if (!(v.x[i] > Ri && v.x[i] < (real)0.3 - Ri && v.y[i] > Ri))
+      continue;
+    int want = m0[i] != 0;
+    for (size_t j = 0; j < v.n && !want; j++) {
+      const real rx = v.x[j] - v.x[i], ry = v.y[j] - v.y[i];
+      const real d = (real)k * (real)0.5 * (v.size[i] + v.size[j]);
+      want = v.size[j] < (real)0.75 * v.size[i] && rx * rx + ry * ry < d * d;
+    }
+    added += m1[i] != 0 && m0[i] == 0;
+    *wrong += (m1[i] != 0) != want;
+  }
+  run_close(&r0);
+  run_close(&r1);
+  return added;
+}
+
+static void test_crowding(void) {
+  long wrong8, wrong95;
+  const long a8 = crowd_marks(0.8, &wrong8), a95 = crowd_marks(0.95, &wrong95);
+  printf("\n  coarse particles crowding marks away from the walls: %ld at 0.8 (wrong %ld), "
+         "%ld at 0.95 (wrong %ld) ",
+         a8, wrong8, a95, wrong95);
+  CU_ASSERT_EQUAL(wrong8, 0);
+  CU_ASSERT_EQUAL(wrong95, 0);
+  CU_ASSERT(a8 > 0 && a95 > a8);
+}
+
 /* A tank in a box of walls, every particle split at once (criterion 5 with no bound);
  * PARTICLES: the particles line of the scene. */
 #define SPLIT_ALL_SCENE(PARTICLES)                                                                 \
@@ -1706,6 +1767,7 @@ int main(void) {
       {"a split round conserves mass and momenta", test_split_conservation},
       {"... also with the 1 -> 3 triangle", test_split_conservation_triangle},
       {"criterion 3 within f R_i (surface_band 1 and 0.6) against a direct sum", test_surface_band},
+      {"crowding (0.8 and 0.95) against a direct search", test_crowding},
       {"split geometry and children's state", test_split_geometry},
       {"split pattern on a strained lattice", test_split_strained_lattice},
       {"the 1 -> 3 triangle: geometry and children's state", test_split_triangle},

@@ -331,6 +331,7 @@ static const struct {
     {"refine_surface_band_range.yaml", 13, "refinement.surface_band", "must be in [0.5, 1]"},
     {"refine_surface_band_triangle.yaml", 14, "refinement.surface_band", "must be in [0.5774, 1]"},
     {"refine_surface_band_no_criterion.yaml", 12, "refinement.surface_band", "needs criterion 3"},
+    {"refine_crowding_range.yaml", 12, "refinement.crowding", "must be in [0, 1)"},
     {"refine_pattern_unknown.yaml", 12, "refinement.pattern", "hexagon"},
     {"shifting_switch_unknown.yaml", 11, "scheme.shifting_switch", "continuity"},
     {"refine_triangle_regions.yaml", 14, "refinement.regions", "need refinement.pattern: square"},

@@ -26,6 +26,8 @@ typedef struct {
   real dx_min;      /* no particle is split below this size */
   int free_surface; /* criterion 3 */
   real band;        /* criterion 3's reach over R_i (refinement.surface_band; 1: the paper) */
+  real crowd;       /* refinement.crowding: split where a finer particle is nearer than crowd
+                       times the mean of the two sizes (ours; 0: off) */
   int walls;        /* criterion 4 */
   int field;        /* criterion 5 */
   rhod_quantity qty;

@@ -109,6 +109,10 @@ typedef enum {
 
 /* Most particle sizes a scene may use: dx, dx/e, ..., dx/e^(RHOD_MAX_LEVELS-1). */
 #define RHOD_MAX_LEVELS 8
+/* refinement.crowding's default: split a particle when a finer one stands nearer than
+ * this times the mean of their sizes (about 1 where the sizes tile the plane).
+ * docs/choices.md "crowding at size jumps" */
+#define RHOD_CROWDING_DEFAULT 0.75
 /* Most iterations of the initial relaxation (particles.relax). */
 #define RHOD_RELAX_MAX 100000
 
@@ -221,6 +225,8 @@ typedef struct {
                               (criteria 1 and 2 always), default true when levels > 1 */
   int refine_free_surface; /* refinement.free_surface: criterion 3, default false */
   double refine_band;      /* refinement.surface_band: criterion 3's reach over R_i, default 1 */
+  double refine_crowding;  /* refinement.crowding: split where a finer particle is nearer than
+                              this times the mean of the two sizes (ours), 0 = off */
   int refine_walls;        /* refinement.walls: criterion 4, default false */
   int refine_field;        /* refinement.field given: criterion 5 */
   int refine_coalesce;     /* refinement.coalesce: merge back where no criterion
