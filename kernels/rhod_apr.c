@@ -125,8 +125,9 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
  * leaves i out), added to the variables named (which hold the self terms): Gamma_ij =
  * W(r_ij; R) V_j over sizes >= big into same (criterion 2), any size <= small into
  * anysmall (criterion 1), any size below own nearer than ck (own + dx_j)/2 into crowded
- * (refinement.crowding, ck = 0: never), and the Shepard sums of the criterion-5 field into num, den
- * (computed always, used only with c5: a branch would keep the loop from vectorising).
+ * (refinement.crowding, ck = 0: never), and the Shepard sums of the criterion-5 field
+ * into num, den (computed always, used only with c5: a branch would keep the loop from
+ * vectorising).
  * One text for a particle's own support and for the support e R_i of the particle its
  * coalescing group would make. Reads the rows the last right-hand side packed in cell
  * order (RHOD_PK_*) in vector lanes (cells.h RHOD_FOR_LANES), as the scheme's gathers do.
