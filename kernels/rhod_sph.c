@@ -30,6 +30,12 @@
   const real r = sqrt(r2), ir = 1 / r;                                                             \
   const real nx = rx * ir, ny = ry * ir
 
+/* a balanced scheme.shifting_switch: the Eq. 4 momentum term of pass C with du' at the
+ * size jumps (rhod_sph_pass_jumps) */
+static inline int rhod_sph_balanced(const rhod_sph *s) {
+  return s->shsw == RHOD_SHSW_BALANCED || s->shsw == RHOD_SHSW_BALANCED_MOMENTUM;
+}
+
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   memset(s, 0, sizeof *s);
   s->kernel = sc->kernel;
@@ -85,7 +91,13 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   F(reg, 1);
   if (s->visc_cons) /* a scene without it does not carry it */
     F(lapB, 3);
-  F(pk, RHOD_PK_ROWS);
+  const int bal = rhod_sph_balanced(s);
+  if (bal) {
+    F(jmp, 1);
+    F(jM, 3);
+    F(dup, 2);
+  }
+  F(pk, bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS);
   if (s->adlim) {
     st = st == RHOD_OK ? rhod_particles_add_field(p, "adv", (void **)&s->adv, 2 * sizeof *s->adv, 1)
                        : st;
@@ -148,7 +160,7 @@ static void pack_a(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
 static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   const long nt = (long)(p->n + p->ng), st = (long)p->cap;
   const int32_t *CI = c->idx;
-  const real *D = s->D, *gP = s->gP, *gu = s->gu, *du = s->du, *rho = p->rho;
+  const real *D = s->D, *gP = s->gP, *gu = s->gu, *du = s->du, *rho = p->rho, *dup = s->dup;
   real *pk = s->pk;
   RHOD_KERNEL_LOOP
   for (long k = 0; k < nt; k++) {
@@ -159,6 +171,8 @@ static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
     pk[RHOD_PK_GU2 * st + k] = gu[4 * j + 2], pk[RHOD_PK_GU3 * st + k] = gu[4 * j + 3];
     pk[RHOD_PK_DUX * st + k] = du[2 * j], pk[RHOD_PK_DUY * st + k] = du[2 * j + 1];
     pk[RHOD_PK_RHO * st + k] = rho[j];
+    if (dup) /* a balanced shifting switch only */
+      pk[RHOD_PK_DPX * st + k] = dup[2 * j], pk[RHOD_PK_DPY * st + k] = dup[2 * j + 1];
   }
 }
 
@@ -189,9 +203,10 @@ static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
       const real *dx, const real *P, const real *V, const real *pk, long st, real *gam,            \
       real *ggam, real *L, real *gP, real *gu, real *D, real *gC, real *uch, real *lam,            \
-      real *lapB, const real ratio, const int vcons
+      real *lapB, uint8_t *jmp, const real ratio, const int vcons
 #define PA_ARGS                                                                                    \
-  G, CS, x, y, ux, uy, dx, P, V, pk, st, gam, ggam, L, gP, gu, D, gC, uch, lam, lapB, ratio, vcons
+  G, CS, x, y, ux, uy, dx, P, V, pk, st, gam, ggam, L, gP, gu, D, gC, uch, lam, lapB, jmp, ratio,  \
+      vcons
 
 PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
@@ -204,7 +219,8 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   real RHOD_LANES(sg), RHOD_LANES(sggx), RHOD_LANES(sggy), RHOD_LANES(sB0), RHOD_LANES(sB1),
       RHOD_LANES(sB2), RHOD_LANES(sB3), RHOD_LANES(sGPx), RHOD_LANES(sGPy), RHOD_LANES(sGu0),
       RHOD_LANES(sGu1), RHOD_LANES(sGu2), RHOD_LANES(sGu3), RHOD_LANES(scx), RHOD_LANES(scy),
-      RHOD_LANES(such);
+      RHOD_LANES(such), RHOD_LANES(sjmp);
+  const real tol = RHOD_SIZE_TOL * dxi;
   RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
     RHOD_FOR_LANES(k0, kv, k) {
       PAIR_OR_SKIP(k);
@@ -228,6 +244,7 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
       RHOD_LANE(scx) += f * gwx, RHOD_LANE(scy) += f * gwy;
       const real un = fabs(dux * nx + duy * ny); /* U_char, after Eq. 27 */
       RHOD_LANE(such) = un > RHOD_LANE(such) ? un : RHOD_LANE(such);
+      RHOD_LANE(sjmp) = fabs(dxj - dxi) > tol ? 1 : RHOD_LANE(sjmp); /* another size */
     }
     RHOD_END_LANES
   }
@@ -246,6 +263,8 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   D[i] = div;
   gC[2 * i] = cx, gC[2 * i + 1] = cy;
   uch[i] = um;
+  if (jmp) /* a balanced shifting switch: another size within R_i (rhod_sph_pass_jumps) */
+    jmp[i] = RHOD_LANES_MAX(sjmp) > 0;
   const real Bm[4] = {B0, B1, B2, B3};
   lam[i] = rhod_min_eig_sym(Bm);
   /* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
@@ -339,6 +358,7 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const real *P = s->P, *V = s->V, *pk = s->pk;
   real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *gC = s->gC,
        *uch = s->uch, *lam = s->lam, *lapB = s->lapB;
+  uint8_t *jmp = s->shifting ? s->jmp : NULL;
   const int kern = s->kernel, vcons = s->visc_cons, generic = s->generic;
   const real ratio = s->ratio;
   (void)generic;
@@ -388,6 +408,108 @@ void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p) {
     O[3] = M2 * J[2] + M3 * J[3];
     D[g] = ghost_div(J, T, U, D[k]);
   }
+}
+
+/* The size jumps of a balanced scheme.shifting_switch (our choice, docs/choices.md
+ * "Shifting terms at size jumps"). The Eq. 4 momentum term's torque plus that of moving the
+ * particles at u + du (Eq. 3's dx/dt) is, summed over the fluid,
+ *   sum m (x x u) ((c s - sigma) . du') - sum m ((M du' - du) x u),
+ * with s = sum grad_i W(r_ij, R_i) V_j the gather gradient of Gamma (Eq. 27), sigma =
+ * sum grad_i W(r_ij, R_j) V_j the scatter one, M = sum V_j r |dW/dr(r_ij, R_j)| n_ij n_ij
+ * the scatter moment, c = +1 in the sum form of Eq. 4 and -1 in the difference form, and
+ * du' the shifting velocity that the momentum term carries (cases/rotating_square/
+ * RESULTS.md "The shifting at a size jump"). Where every particle within reach has i's size,
+ * sigma = s and M = B of Eq. 8, so the paper's sum form leaves only the (B - I) du part,
+ * as in single resolution. At a size jump sigma != s and M != B: there the momentum term
+ * takes the difference form with du' = M^-1 du, which removes the second sum. A jump
+ * particle has one of another size within max(R_i, R_j). Pass A flags those with one
+ * within R_i; a coarser j with R_i <= r < R_j is itself flagged (i lies within its R_j),
+ * and so are the ghosts. So a particle that pass A did not flag looks for such a j among
+ * the flagged ones alone (the cells' subset, with their x, y, V and dx packed in its
+ * order), and skips even that when none lies within the largest radius (two reads per row
+ * of the subset). Writes jmp (1 at a jump) and jM (M there, 0 elsewhere) of the fluid. */
+PARTICLE_BODY void jumps_particle(long i, const rhod_grid G, const int32_t *CS, const rhod_grid GS,
+                                  const int32_t *SS, const real *x, const real *y, const real *dx,
+                                  const real *pk, long st, uint8_t *jmp, real *jM, const real ratio,
+                                  const real dmax, const int kern) {
+  const real xi = x[i], yi = y[i], dxi = dx[i], Ri = ratio * dxi, R2 = Ri * Ri;
+  const real tol = RHOD_SIZE_TOL * dxi, Rmax = ratio * dmax;
+  const int own = jmp[i];
+  const int far = dxi < dmax - tol && rhod_cells_near_any(GS, SS, xi, yi, Rmax);
+  real mxx = 0, mxy = 0, myy = 0, cross = own;
+  if (own || far) {
+    real RHOD_LANES(sxx), RHOD_LANES(sxy), RHOD_LANES(syy), RHOD_LANES(sfar);
+    /* within R_i: every neighbour, with W at its own radius R_j (0 beyond it) */
+    const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
+               *kdx = pk + RHOD_PK_DX * st;
+    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+      RHOD_FOR_LANES(k0, kv, k) {
+        PAIR_OR_SKIP(k);
+        const real Rj = ratio * kdx[k], iRj = 1 / Rj;
+        const real a = r < Rj ? -rhod_dWq(kern, r * iRj) * iRj * iRj * iRj * kV[k] * r : 0;
+        RHOD_LANE(sxx) += a * nx * nx, RHOD_LANE(sxy) += a * nx * ny;
+        RHOD_LANE(syy) += a * ny * ny;
+      }
+      RHOD_END_LANES
+    }
+    RHOD_END_ROWS
+    /* beyond R_i: the coarser flagged ones whose R_j reaches i */
+    if (far) {
+      const real *fx = pk + RHOD_PK_JX * st, *fy = pk + RHOD_PK_JY * st, *fV = pk + RHOD_PK_JV * st,
+                 *fdx = pk + RHOD_PK_JDX * st;
+      RHOD_FOR_ROWS(GS, SS, xi, yi, Rmax, k0, k1, kv) {
+        RHOD_FOR_LANES(k0, kv, k) {
+          const real rx = fx[k] - xi, ry = fy[k] - yi, r2 = rx * rx + ry * ry;
+          const real Rj = ratio * fdx[k];
+          if (!(r2 >= R2 && r2 < Rj * Rj))
+            continue;
+          const real r = sqrt(r2), nx = rx / r, ny = ry / r, iRj = 1 / Rj;
+          const real a = -rhod_dWq(kern, r * iRj) * iRj * iRj * iRj * fV[k] * r;
+          RHOD_LANE(sxx) += a * nx * nx, RHOD_LANE(sxy) += a * nx * ny;
+          RHOD_LANE(syy) += a * ny * ny;
+          RHOD_LANE(sfar) = 1;
+        }
+        RHOD_END_LANES
+      }
+      RHOD_END_ROWS
+      cross = RHOD_LANES_MAX(sfar) > 0 ? 1 : cross;
+    }
+    if (cross > 0)
+      mxx = RHOD_LANES_SUM(sxx), mxy = RHOD_LANES_SUM(sxy), myy = RHOD_LANES_SUM(syy);
+  }
+  jmp[i] = cross > 0;
+  jM[3 * i] = mxx, jM[3 * i + 1] = mxy, jM[3 * i + 2] = myy;
+}
+
+void rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
+  if (!rhod_sph_balanced(s) || !s->shifting)
+    return;
+  const long n = (long)p->n, nt = (long)(p->n + p->ng), st = (long)p->cap;
+  uint8_t *jmp = s->jmp;
+  real *jM = s->jM, *pk = s->pk;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *V = s->V;
+  real dmax = 0;
+  RHOD_KERNEL_LOOP_REDUCE(max, dmax)
+  for (long i = 0; i < nt; i++)
+    dmax = dx[i] > dmax ? dx[i] : dmax;
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++)
+    jmp[g] = 1;
+  const long nf = rhod_cells_build_subset(c, jmp);
+  const int32_t *CI = c->sub->idx;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nf; k++) {
+    const int j = CI[k];
+    pk[RHOD_PK_JX * st + k] = x[j], pk[RHOD_PK_JY * st + k] = y[j];
+    pk[RHOD_PK_JV * st + k] = V[j], pk[RHOD_PK_JDX * st + k] = dx[j];
+  }
+  const rhod_grid G = c->g, GS = c->sub->g;
+  const int32_t *CS = c->start, *SS = c->sub->start;
+  const real ratio = s->ratio;
+  const int kern = s->kernel, generic = s->generic;
+  (void)generic;
+  GATHER_BY_KERNEL(n, kern, generic, jumps_particle, G, CS, GS, SS, x, y, dx, pk, st, jmp, jM,
+                   ratio, dmax);
 }
 
 /* Free-surface detection of Marrone et al. 2010 (paper 002 Ref. 51; scheme.md step 3):
@@ -582,14 +704,19 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
 /* Shifting velocity, Eqs. 25-27 (no gather: grad C and U_char come from pass A). */
 void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
   const long n = (long)p->n, nt_ = (long)(p->n + p->ng);
-  real *du = s->du;
+  real *du = s->du, *dup = s->dup;
   if (!s->shifting) {
     RHOD_KERNEL_LOOP
-    for (long i = 0; i < nt_; i++)
+    for (long i = 0; i < nt_; i++) {
       du[2 * i] = 0, du[2 * i + 1] = 0;
+      if (dup)
+        dup[2 * i] = 0, dup[2 * i + 1] = 0;
+    }
     return;
   }
   const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *uch = s->uch, *ggam = s->ggam, *dx = p->dx;
+  const real *jM = s->jM;
+  const uint8_t *jmp = s->jmp;
   const real ratio = s->ratio, a = s->sa, b = s->sb, eps = s->seps;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
@@ -605,7 +732,21 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
         f = f3 < f ? f3 : f;
       }
     }
-    du[2 * i] = f * Jx, du[2 * i + 1] = f * Jy;
+    const real ux_ = f * Jx, uy_ = f * Jy;
+    du[2 * i] = ux_, du[2 * i + 1] = uy_;
+    if (dup) {
+      /* a balanced shifting switch (rhod_sph_pass_jumps): du' = M^-1 du at a size jump.
+       * Our choice: where det M <= 0.1 (a support too empty to invert; M = I on a full
+       * one) du' = du */
+      real px = ux_, py = uy_;
+      const real mxx = jM[3 * i], mxy = jM[3 * i + 1], myy = jM[3 * i + 2];
+      const real det = mxx * myy - mxy * mxy;
+      if (jmp[i] && det > (real)0.1) {
+        const real id = 1 / det;
+        px = id * (myy * ux_ - mxy * uy_), py = id * (mxx * uy_ - mxy * ux_);
+      }
+      dup[2 * i] = px, dup[2 * i + 1] = py;
+    }
   }
   const int32_t *gsrc = p->gsrc;
   const real *gJ = p->gJ;
@@ -616,15 +757,20 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
     const real vx = du[2 * k], vy = du[2 * k + 1];
     du[2 * g] = J[0] * vx + J[1] * vy;
     du[2 * g + 1] = J[2] * vx + J[3] * vy;
+    if (dup) /* our choice: a ghost carries du' = du (its mirror's du) */
+      dup[2 * g] = du[2 * g], dup[2 * g + 1] = du[2 * g + 1];
   }
 }
 
 /* Pass A, the free-surface detection and the region pass, with the ghosts' mirrors: what
  * the shifting direction (Eqs. 25-26) needs; the start of every right-hand side and of
- * every relaxation iteration. */
-static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
+ * every relaxation iteration. With jumps, the size jumps of pass C's momentum term too
+ * (the relaxation does not need them). */
+static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c, int jumps) {
   rhod_sph_pass_a(s, p, c);
   rhod_sph_mirror_gradients(s, p);
+  if (jumps)
+    rhod_sph_pass_jumps(s, p, c);
   rhod_sph_pass_free_surface(s, p, c);
   rhod_sph_mirror_surface(s, p);
   rhod_sph_pass_region(s, p, c);
@@ -648,7 +794,7 @@ static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c)
  * (rhod_sim_prepare); moves the fluid particles only and leaves every other field as it
  * was. */
 void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx) {
-  gradients_and_surface(s, p, c);
+  gradients_and_surface(s, p, c, 0);
   const long n = (long)p->n, st = (long)p->cap;
   real *x = p->x, *y = p->y;
   const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *ggam = s->ggam, *dx = p->dx;
@@ -699,20 +845,22 @@ void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx
  * particles, and a branch on a switch is uniform across them). */
 typedef struct {
   real ratio, c0, rho0, ic2, gx, gy, alpha_ad, gth, tth, visc_k, mu;
-  int flags; /* PC_VCONS | PC_TIC | PC_SHSW | PC_SHSWC: one int, since with two GCC 12 nvptx put the
-                struct in a lane-shared frame (tests/offload_frames.sh) */
+  int flags; /* PC_VCONS | PC_TIC | PC_SHSW | PC_SHSWC | PC_SHBAL: one int, since with two GCC 12
+                nvptx put the struct in a lane-shared frame (tests/offload_frames.sh) */
 } pass_c_consts;
-/* the consistent Laplacian; scheme.tensile_control; scheme.shifting_switch */
-enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4, PC_SHSWC = 8 };
+/* the consistent Laplacian; scheme.tensile_control; scheme.shifting_switch: the momentum
+ * term's difference form, the continuity terms', the balanced momentum term */
+enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4, PC_SHSWC = 8, PC_SHBAL = 16 };
 
 #define PC_PARAMS                                                                                  \
   rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
       const real *rho, const real *dx, const real *P, const real *L, const real *gP,               \
-      const real *gu, const real *D, const real *du, const real *gam, const uint8_t *reg,          \
-      const real *lapB, const real *pk, long st, real *drho, real *acc, real *vel,                 \
-      const pass_c_consts K
+      const real *gu, const real *D, const real *du, const real *dup, const uint8_t *jmp,          \
+      const real *gam, const uint8_t *reg, const real *lapB, const real *pk, long st, real *drho,  \
+      real *acc, real *vel, const pass_c_consts K
 #define PC_ARGS                                                                                    \
-  G, CS, x, y, ux, uy, rho, dx, P, L, gP, gu, D, du, gam, reg, lapB, pk, st, drho, acc, vel, K
+  G, CS, x, y, ux, uy, rho, dx, P, L, gP, gu, D, du, dup, jmp, gam, reg, lapB, pk, st, drho, acc,  \
+      vel, K
 
 PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int riemann,
                                    const int recon, const int shifting, const int visc) {
@@ -728,6 +876,10 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   const real iR = 1 / Ri, iR3 = iR * iR * iR;
   const real uxi = ux[i], uyi = uy[i], rhoi = rho[i], Pi = P[i], Di = D[i];
   const real dui = du[2 * i], dvi = du[2 * i + 1];
+  /* the du' of the momentum term: du, or with a balanced switch rhod_sph_pass_jumps' */
+  const int bal = (K.flags & PC_SHBAL) != 0;
+  const real dpi = bal ? dup[2 * i] : dui, dqi = bal ? dup[2 * i + 1] : dvi;
+  const real *kdpx = bal ? pk + RHOD_PK_DPX * st : kdux, *kdpy = bal ? pk + RHOD_PK_DPY * st : kduy;
   const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];
   const real Gi0 = gu[4 * i], Gi1 = gu[4 * i + 1], Gi2 = gu[4 * i + 2], Gi3 = gu[4 * i + 3];
   /* Which sums are renormalised is known before the loop (Eq. 6: i in I and
@@ -804,10 +956,11 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
       if (shifting) {
         const real duj = kdux[k], dvj = kduy[k], rhoj = krho[k];
         const real dun_i = dui * nx + dvi * ny, dun_j = duj * nx + dvj * ny;
+        const real dpn_i = dpi * nx + dqi * ny, dpn_j = kdpx[k] * nx + kdpy[k] * ny;
         RHOD_LANE(sddu) += (dun_j - dun_i) * F;
         RHOD_LANE(sdrdu) += (rhoi * dun_i + rhoj * dun_j) * F;
-        RHOD_LANE(sruux) += (rhoi * uxi * dun_i + rhoj * uxj * dun_j) * F;
-        RHOD_LANE(sruuy) += (rhoi * uyi * dun_i + rhoj * uyj * dun_j) * F;
+        RHOD_LANE(sruux) += (rhoi * uxi * dpn_i + rhoj * uxj * dpn_j) * F;
+        RHOD_LANE(sruuy) += (rhoi * uyi * dpn_i + rhoj * uyj * dpn_j) * F;
       }
     }
     RHOD_END_LANES
@@ -851,9 +1004,13 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
      * its angular momentum; with both the four-level dam break gained energy and stopped
      * at t = 1.52 s, with the momentum term alone it runs to t sqrt(g/H) = 10). The
      * free-surface region keeps the sum form, as Eq. 6 keeps its conservative form there.
-     * sf = sum grad_i W_ij V_j, so the switch costs nothing in the loop. */
+     * sf = sum grad_i W_ij V_j, so the switch costs nothing in the loop. The balanced
+     * forms (PC_SHBAL) keep the sum form except at a size jump, where the difference form
+     * carries du' (rhod_sph_pass_jumps). */
     const real g2 = renP * 2 * (dui * sfx + dvi * sfy);
-    const real dsm = (K.flags & PC_SHSW) ? g2 : 0, dsc = (K.flags & PC_SHSWC) ? g2 : 0;
+    const real dsm =
+        bal ? (jmp[i] ? renP * 2 * (dpi * sfx + dqi * sfy) : 0) : ((K.flags & PC_SHSW) ? g2 : 0);
+    const real dsc = (K.flags & PC_SHSWC) ? g2 : 0;
     dr += -rhoi * ddu + drdu - rhoi * dsc;
     fx += ruux - rhoi * uxi * dsm, fy += ruuy - rhoi * uyi * dsm;
   }
@@ -886,8 +1043,8 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const int32_t *CS = c->start;
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *dx = p->dx;
   const real *P = s->P, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *du = s->du, *gam = s->gam,
-             *lapB = s->lapB, *pk = s->pk;
-  const uint8_t *reg = s->reg;
+             *lapB = s->lapB, *pk = s->pk, *dup = s->dup;
+  const uint8_t *reg = s->reg, *jmp = s->jmp;
   real *drho = s->drho, *acc = s->acc, *vel = s->vel;
   const pass_c_consts K = {
       .ratio = s->ratio,
@@ -902,8 +1059,9 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       .visc_k = 2 * (RHOD_DIM + 2) * s->mu, /* Eq. 10 */
       .mu = s->mu,
       .flags = (s->visc_cons ? PC_VCONS : 0) | (s->tic ? PC_TIC : 0) |
-               (s->shsw != RHOD_SHSW_NONE ? PC_SHSW : 0) |
-               (s->shsw == RHOD_SHSW_ALL ? PC_SHSWC : 0),
+               (s->shsw == RHOD_SHSW_MOMENTUM || s->shsw == RHOD_SHSW_ALL ? PC_SHSW : 0) |
+               (s->shsw == RHOD_SHSW_ALL || s->shsw == RHOD_SHSW_BALANCED ? PC_SHSWC : 0) |
+               (rhod_sph_balanced(s) ? PC_SHBAL : 0),
   };
   const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
             shifting = s->shifting, visc = s->mu != 0;
@@ -928,7 +1086,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
 }
 
 void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt) {
-  gradients_and_surface(s, p, c);
+  gradients_and_surface(s, p, c, 1);
   rhod_sph_pass_shift(s, p, dt);
   rhod_sph_pass_c(s, p, c);
 }

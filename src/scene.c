@@ -254,6 +254,8 @@ static const cyaml_strval_t shifting_switch_names[] = {
     {"false", RHOD_SHSW_NONE},
     {"momentum", RHOD_SHSW_MOMENTUM},
     {"true", RHOD_SHSW_ALL},
+    {"balanced", RHOD_SHSW_BALANCED},
+    {"balanced_momentum", RHOD_SHSW_BALANCED_MOMENTUM},
 };
 static const cyaml_strval_t relax_where_names[] = {
     {"all", RHOD_RELAX_ALL},

@@ -199,6 +199,7 @@ static void test_overrides(void) {
       "fluid.1={circle: {center: [0.5, 0.25], radius: 0.1}}", /* appended block */
       "probes.list.0.front.name=X",                           /* built from nothing */
       "scheme.riemann=false",
+      "scheme.shifting_switch=balanced_momentum",
       "name=renamed",
   };
   int n = (int)(sizeof ov / sizeof ov[0]);
@@ -219,6 +220,7 @@ static void test_overrides(void) {
   CU_ASSERT_EQUAL(s->probes[0].kind, RHOD_PROBE_FRONT);
   CU_ASSERT_STRING_EQUAL(s->probes[0].name, "X");
   CU_ASSERT_FALSE(s->riemann);
+  CU_ASSERT_EQUAL(s->shifting_switch, RHOD_SHSW_BALANCED_MOMENTUM);
   CU_ASSERT_STRING_EQUAL(s->name, "renamed");
   /* the scene as run holds the overridden values */
   CU_ASSERT_PTR_NOT_NULL(strstr(s->yaml, "end: 0.5\n"));

@@ -130,8 +130,17 @@ typedef enum { RHOD_RELAX_ALL = 0, RHOD_RELAX_JUMPS } rhod_relax_where;
 /* scheme.shifting_switch: where Eq. 6 is renormalised, which of the Eq. 4 divergences
  * take the difference form instead of the paper's sum form (docs/choices.md "Shifting
  * terms at size jumps"): none (false), the momentum term alone (momentum), or the
- * momentum and continuity terms (true). */
-typedef enum { RHOD_SHSW_NONE = 0, RHOD_SHSW_MOMENTUM, RHOD_SHSW_ALL } rhod_shifting_switch;
+ * momentum and continuity terms (true). The balanced forms keep the momentum term's sum
+ * form except at the particles of a size jump, where it takes the difference form with
+ * du' = M^-1 du (rhod_sph_pass_jumps): with the continuity terms switched as in `true`
+ * (balanced) or not (balanced_momentum). */
+typedef enum {
+  RHOD_SHSW_NONE = 0,
+  RHOD_SHSW_MOMENTUM,
+  RHOD_SHSW_ALL,
+  RHOD_SHSW_BALANCED,
+  RHOD_SHSW_BALANCED_MOMENTUM
+} rhod_shifting_switch;
 
 /* refinement.pattern: how a particle splits (paper 002 Sec. V A and Appendix, Fig. 32).
  * Square: 1 -> 4, level size ratio e = dx_l / dx_(l+1) = 2 (the paper's pattern);

@@ -44,7 +44,17 @@ enum {
   RHOD_PK_FX = RHOD_PK_D,
   RHOD_PK_FY = RHOD_PK_GPX,
   RHOD_PK_FNX = RHOD_PK_GPY,
-  RHOD_PK_FNY = RHOD_PK_GU0
+  RHOD_PK_FNY = RHOD_PK_GU0,
+  /* rhod_sph_pass_jumps' rows, in pass C's too: the positions, volumes and sizes of the
+   * particles it flagged, in the order of the cells' subset */
+  RHOD_PK_JX = RHOD_PK_D,
+  RHOD_PK_JY = RHOD_PK_GPX,
+  RHOD_PK_JV = RHOD_PK_GPY,
+  RHOD_PK_JDX = RHOD_PK_GU0,
+  /* with a balanced scheme.shifting_switch: du' of rhod_sph_pass_jumps (packed by pass C) */
+  RHOD_PK_DPX = RHOD_PK_ROWS,
+  RHOD_PK_DPY,
+  RHOD_PK_ROWS_BALANCED
 };
 
 typedef struct {
@@ -82,6 +92,11 @@ typedef struct {
   real *nrm;              /* free-surface normal, 2 */
   real *nt, *sig;         /* shifting projection normal and weight (Eq. 26), 2 and 1 */
   real *du;               /* shifting velocity (Eq. 27), 2 */
+  uint8_t *jmp;           /* with a balanced shifting switch: 1 where a particle of another
+                             size lies within max(R_i, R_j) (a size jump), from
+                             rhod_sph_pass_jumps (pass A: within R_i; ghosts: 1) */
+  real *jM;               /* there: the scatter moment M_i (xx, xy, yy), 3; 0 elsewhere */
+  real *dup;              /* there: du' = M^-1 du (du elsewhere), 2 */
   real *drho, *acc, *vel; /* time derivatives: d rho/dt, du/dt (2), dx/dt (2) */
   uint8_t *fs;            /* 1: free-surface particle (set F) */
   uint8_t *reg;           /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
@@ -107,6 +122,10 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p);
  * packed in cell order, so it follows pass A over the same cells: */
 void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p);
+/* With a balanced scheme.shifting_switch (and shifting on): the size-jump flags and scatter
+ * moments (jmp, jM) after pass A and its mirrors; it uses and leaves the cells' subset
+ * (the region pass builds it again). Does nothing otherwise. */
+void rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, rhod_cells *c);
 void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p);
 void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c);
