@@ -411,23 +411,22 @@ void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p) {
 }
 
 /* The size jumps of a balanced scheme.shifting_switch (our choice, docs/choices.md
- * "Shifting terms at size jumps"). The Eq. 4 momentum term's torque plus that of moving the
- * particles at u + du (Eq. 3's dx/dt) is, summed over the fluid,
- *   sum m (x x u) ((c s - sigma) . du') - sum m ((M du' - du) x u),
- * with s = sum grad_i W(r_ij, R_i) V_j the gather gradient of Gamma (Eq. 27), sigma =
- * sum grad_i W(r_ij, R_j) V_j the scatter one, M = sum V_j r |dW/dr(r_ij, R_j)| n_ij n_ij
- * the scatter moment, c = +1 in the sum form of Eq. 4 and -1 in the difference form, and
- * du' the shifting velocity that the momentum term carries (cases/rotating_square/
- * RESULTS.md "The shifting at a size jump"). Where every particle within reach has i's size,
- * sigma = s and M = B of Eq. 8, so the paper's sum form leaves only the (B - I) du part,
- * as in single resolution. At a size jump sigma != s and M != B: there the momentum term
- * takes the difference form with du' = M^-1 du, which removes the second sum. A jump
- * particle has one of another size within max(R_i, R_j). Pass A flags those with one
- * within R_i; a coarser j with R_i <= r < R_j is itself flagged (i lies within its R_j),
- * and so are the ghosts. So a particle that pass A did not flag looks for such a j among
- * the flagged ones alone (the cells' subset, with their x, y, V and dx packed in its
- * order), and skips even that when none lies within the largest radius (two reads per row
- * of the subset). Writes jmp (1 at a jump) and jM (M there, 0 elsewhere) of the fluid. */
+ * "balanced shifting switch"; paper 002 Eq. 4 writes the momentum term in the sum form). The Eq. 4
+ * momentum term's torque plus that of moving the particles at u + du (Eq. 3's dx/dt) is, summed
+ * over the fluid, sum m (x x u) ((c s - sigma) . du') - sum m ((M du' - du) x u), with s = sum
+ * grad_i W(r_ij, R_i) V_j the gather gradient of Gamma (Eq. 27), sigma = sum grad_i W(r_ij, R_j)
+ * V_j the scatter one, M = sum V_j r |dW/dr(r_ij, R_j)| n_ij n_ij the scatter moment, c = +1 in the
+ * sum form of Eq. 4 and -1 in the difference form, and du' the shifting velocity that the momentum
+ * term carries (cases/rotating_square/RESULTS.md "The shifting at a size jump"). Where every
+ * particle within reach has i's size, sigma = s and M = B of Eq. 8, so the paper's sum form leaves
+ * only the (B - I) du part, as in single resolution. At a size jump sigma != s and M != B: there
+ * the momentum term takes the difference form with du' = M^-1 du, which removes the second sum. A
+ * jump particle has one of another size within max(R_i, R_j). Pass A flags those with one within
+ * R_i; a coarser j with R_i <= r < R_j is itself flagged (i lies within its R_j), and so are the
+ * ghosts. So a particle that pass A did not flag looks for such a j among the flagged ones alone
+ * (the cells' subset, with their x, y, V and dx packed in its order), and skips even that when none
+ * lies within the largest radius (two reads per row of the subset). Writes jmp (1 at a jump) and jM
+ * (M there, 0 elsewhere) of the fluid. */
 PARTICLE_BODY void jumps_particle(long i, const rhod_grid G, const int32_t *CS, const rhod_grid GS,
                                   const int32_t *SS, const real *x, const real *y, const real *dx,
                                   const real *pk, long st, uint8_t *jmp, real *jM, const real ratio,
