@@ -203,10 +203,10 @@ static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
       const real *dx, const real *P, const real *V, const real *pk, long st, real *gam,            \
       real *ggam, real *L, real *gP, real *gu, real *D, real *gC, real *uch, real *lam,            \
-      real *lapB, uint8_t *jmp, const real ratio, const int vcons
+      real *lapB, uint8_t *jmp, real *jB, const real ratio, const int vcons
 #define PA_ARGS                                                                                    \
-  G, CS, x, y, ux, uy, dx, P, V, pk, st, gam, ggam, L, gP, gu, D, gC, uch, lam, lapB, jmp, ratio,  \
-      vcons
+  G, CS, x, y, ux, uy, dx, P, V, pk, st, gam, ggam, L, gP, gu, D, gC, uch, lam, lapB, jmp, jB,     \
+      ratio, vcons
 
 PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
@@ -263,8 +263,12 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   D[i] = div;
   gC[2 * i] = cx, gC[2 * i + 1] = cy;
   uch[i] = um;
-  if (jmp) /* a balanced shifting switch: another size within R_i (rhod_sph_pass_jumps) */
+  if (jmp) {
+    /* a balanced shifting switch (rhod_sph_pass_jumps): another size within R_i, and B,
+     * which is the scatter moment M within R_i where every neighbour there has i's size */
     jmp[i] = RHOD_LANES_MAX(sjmp) > 0;
+    jB[3 * i] = B0, jB[3 * i + 1] = (real)0.5 * (B1 + B2), jB[3 * i + 2] = B3;
+  }
   const real Bm[4] = {B0, B1, B2, B3};
   lam[i] = rhod_min_eig_sym(Bm);
   /* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
@@ -359,6 +363,7 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   real *gam = s->gam, *ggam = s->ggam, *L = s->L, *gP = s->gP, *gu = s->gu, *D = s->D, *gC = s->gC,
        *uch = s->uch, *lam = s->lam, *lapB = s->lapB;
   uint8_t *jmp = s->shifting ? s->jmp : NULL;
+  real *jB = s->jM;
   const int kern = s->kernel, vcons = s->visc_cons, generic = s->generic;
   const real ratio = s->ratio;
   (void)generic;
@@ -425,8 +430,10 @@ void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p) {
  * R_i; a coarser j with R_i <= r < R_j is itself flagged (i lies within its R_j), and so are the
  * ghosts. So a particle that pass A did not flag looks for such a j among the flagged ones alone
  * (the cells' subset, with their x, y, V and dx packed in its order), and skips even that when none
- * lies within the largest radius (two reads per row of the subset). Writes jmp (1 at a jump) and jM
- * (M there, 0 elsewhere) of the fluid. */
+ * lies within the largest radius (two reads per row of the subset). Within R_i such a particle has
+ * only neighbours of its own size, where M's sum is pass A's B (left in jM), so only the particles
+ * pass A flagged gather M within R_i again. Writes jmp (1 at a jump) and jM (M there, 0 elsewhere)
+ * of the fluid. */
 PARTICLE_BODY void jumps_particle(long i, const rhod_grid G, const int32_t *CS, const rhod_grid GS,
                                   const int32_t *SS, const real *x, const real *y, const real *dx,
                                   const real *pk, long st, uint8_t *jmp, real *jM, const real ratio,
@@ -438,20 +445,25 @@ PARTICLE_BODY void jumps_particle(long i, const rhod_grid G, const int32_t *CS, 
   real mxx = 0, mxy = 0, myy = 0, cross = own;
   if (own || far) {
     real RHOD_LANES(sxx), RHOD_LANES(sxy), RHOD_LANES(syy), RHOD_LANES(sfar);
-    /* within R_i: every neighbour, with W at its own radius R_j (0 beyond it) */
-    const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
-               *kdx = pk + RHOD_PK_DX * st;
-    RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
-      RHOD_FOR_LANES(k0, kv, k) {
-        PAIR_OR_SKIP(k);
-        const real Rj = ratio * kdx[k], iRj = 1 / Rj;
-        const real a = r < Rj ? -rhod_dWq(kern, r * iRj) * iRj * iRj * iRj * kV[k] * r : 0;
-        RHOD_LANE(sxx) += a * nx * nx, RHOD_LANE(sxy) += a * nx * ny;
-        RHOD_LANE(syy) += a * ny * ny;
+    /* within R_i: pass A's B where every neighbour there has i's size; else every
+     * neighbour, with W at its own radius R_j (0 beyond it) */
+    const real bxx = own ? 0 : jM[3 * i], bxy = own ? 0 : jM[3 * i + 1];
+    const real byy = own ? 0 : jM[3 * i + 2];
+    if (own) {
+      const real *kx = pk + RHOD_PK_X * st, *ky = pk + RHOD_PK_Y * st, *kV = pk + RHOD_PK_V * st,
+                 *kdx = pk + RHOD_PK_DX * st;
+      RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+        RHOD_FOR_LANES(k0, kv, k) {
+          PAIR_OR_SKIP(k);
+          const real Rj = ratio * kdx[k], iRj = 1 / Rj;
+          const real a = r < Rj ? -rhod_dWq(kern, r * iRj) * iRj * iRj * iRj * kV[k] * r : 0;
+          RHOD_LANE(sxx) += a * nx * nx, RHOD_LANE(sxy) += a * nx * ny;
+          RHOD_LANE(syy) += a * ny * ny;
+        }
+        RHOD_END_LANES
       }
-      RHOD_END_LANES
+      RHOD_END_ROWS
     }
-    RHOD_END_ROWS
     /* beyond R_i: the coarser flagged ones whose R_j reaches i */
     if (far) {
       const real *fx = pk + RHOD_PK_JX * st, *fy = pk + RHOD_PK_JY * st, *fV = pk + RHOD_PK_JV * st,
@@ -474,7 +486,8 @@ PARTICLE_BODY void jumps_particle(long i, const rhod_grid G, const int32_t *CS, 
       cross = RHOD_LANES_MAX(sfar) > 0 ? 1 : cross;
     }
     if (cross > 0)
-      mxx = RHOD_LANES_SUM(sxx), mxy = RHOD_LANES_SUM(sxy), myy = RHOD_LANES_SUM(syy);
+      mxx = bxx + RHOD_LANES_SUM(sxx), mxy = bxy + RHOD_LANES_SUM(sxy),
+      myy = byy + RHOD_LANES_SUM(syy);
   }
   jmp[i] = cross > 0;
   jM[3 * i] = mxx, jM[3 * i + 1] = mxy, jM[3 * i + 2] = myy;
