@@ -688,3 +688,35 @@ void rhod_snapshot_data_free(rhod_snapshot_data *d) {
   free(d->params.values);
   memset(d, 0, sizeof *d);
 }
+
+int rhod_read_snapshot_header(const char *path, double *time, uint64_t *n, char *err,
+                              size_t errlen) {
+  h5_quiet();
+  reader r = {-1, path, err, errlen};
+  int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    set_err(err, errlen, "%s: cannot read: %s", path, strerror(errno));
+    return RHOD_ERR_READ;
+  }
+  close(fd);
+  r.file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (r.file < 0)
+    return rfail(&r, "the file");
+  int rc = RHOD_OK;
+  hid_t h = -1;
+  if (H5Lexists(r.file, "/Header", H5P_DEFAULT) <= 0) {
+    set_err(err, errlen, "%s: missing group /Header", path);
+    rc = RHOD_ERR_READ;
+  } else if ((h = H5Gopen2(r.file, "/Header", H5P_DEFAULT)) < 0) {
+    rc = rfail(&r, "/Header");
+  }
+  if (!rc)
+    rc = read_attr(&r, h, "Time", H5T_NATIVE_DOUBLE, time);
+  if (!rc)
+    rc = read_attr(&r, h, "NumPart", H5T_NATIVE_UINT64, n);
+  if (h >= 0)
+    H5Gclose(h);
+  H5Fclose(r.file);
+  H5Eclear2(H5E_DEFAULT);
+  return rc;
+}

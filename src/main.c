@@ -1,10 +1,16 @@
 /* rhod: command line. The only place that prints to the terminal and exits. */
-#define _XOPEN_SOURCE 700 /* realpath, sigaction types */
+#define _GNU_SOURCE /* getopt_long, flock, realpath */
 #include "rhod/checkpoint.h"
 #include "rhod/io.h"
 #include "rhod/scene.h"
+#include "rhod/schedule.h"
 #include "rhod/sim.h"
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <float.h>
+#include <getopt.h>
+#include <jansson.h>
 #include <math.h>
 #include <omp.h>
 #include <signal.h>
@@ -12,43 +18,116 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
 #define ERRLEN 1024
+#define MAX_SETS 256
 
 static const char *USAGE =
     "usage: rhod run SCENE [-o OUT] [--set dotted.key=value]... [--checkpoint-every T]\n"
+    "                [--overwrite]\n"
     "       rhod resume OUT\n"
-    "       rhod --help | --version\n"
+    "       rhod check SCENE [--set dotted.key=value]...\n"
+    "       rhod help [run | resume | check] | --help | --version\n";
+
+static const char *HELP_RUN =
+    "usage: rhod run SCENE [options]\n"
     "Runs the scene and writes snapshots (HDF5 + XDMF), pictures (PNG), probes.csv,\n"
-    "summary.json and run.log to OUT (default out/<scene file's folder name>).\n"
-    "--checkpoint-every T writes OUT/checkpoint.rhod every T simulated seconds; SIGINT or\n"
-    "SIGTERM writes one and stops. `rhod resume OUT` continues from it, bit for bit.\n"
+    "summary.json, run.log, scene.yaml (the scene as run) and the walls (walls.h5,\n"
+    "walls.xdmf) into the output folder.\n"
+    "  -o, --output=DIR          output folder (default out/NAME, NAME the scene file's name\n"
+    "                            without .yaml, or its folder's name for a scene.yaml)\n"
+    "      --set=KEY=VALUE       overrides a key of the scene (dotted path, e.g.\n"
+    "                            particles.dx=0.01 or fluid.0.velocity=[1,0]); repeatable\n"
+    "      --checkpoint-every=T  writes OUT/checkpoint.rhod every T simulated seconds\n"
+    "      --overwrite           the output folder may hold an earlier run: its run files\n"
+    "                            are removed first (other files are kept)\n"
+    "  -h, --help                this text\n"
+    "A folder that is not empty is refused without --overwrite; one run writes into a\n"
+    "folder at a time. SIGINT or SIGTERM writes a checkpoint and stops (exit 9).\n"
     "Exit codes: 0 ok, 2 usage, 3 unreadable scene, 4 invalid scene, 5 output folder,\n"
     "6 unstable run, 7 write error during the run, 8 out of memory, 9 interrupted\n"
     "(checkpoint written), 10 bad or unfitting checkpoint.\n";
 
+static const char *HELP_RESUME =
+    "usage: rhod resume OUT\n"
+    "Continues the run in OUT from OUT/checkpoint.rhod, bit for bit. The scene file and its\n"
+    "--set overrides are those of the checkpoint; a scene that changed since, or output\n"
+    "files that do not belong to the checkpoint's run, are refused (exit 10).\n"
+    "  -h, --help   this text\n";
+
+static const char *HELP_CHECK =
+    "usage: rhod check SCENE [--set=KEY=VALUE]...\n"
+    "Loads and validates the scene, builds the initial particles and prints their count,\n"
+    "the memory they need, the first time step and an estimate of the number of steps.\n"
+    "Writes nothing.\n"
+    "  -h, --help   this text\n";
+
+/* ---- terminal output ------------------------------------------------------------------ */
+
 /* SIGINT/SIGTERM: the loop stops after the step in progress, writes a checkpoint and
- * exits with RHOD_ERR_INTERRUPTED. */
+ * exits with RHOD_ERR_INTERRUPTED. The handler stays installed (sigaction without
+ * SA_RESETHAND), so a second signal only sets the flag again. */
 static volatile sig_atomic_t g_stop;
 static void on_signal(int sig) { g_stop = sig; }
 
 static FILE *g_log;
+static int g_progress_shown; /* a live progress line (no newline) is on the terminal */
 
+/* A message as one line: control characters (a newline in a key or path) are escaped. */
+static void one_line(const char *in, char *out, size_t len) {
+  size_t k = 0;
+  for (const unsigned char *q = (const unsigned char *)in; *q && k + 5 < len; q++) {
+    if (*q == '\n')
+      out[k++] = '\\', out[k++] = 'n';
+    else if (*q == '\t')
+      out[k++] = '\\', out[k++] = 't';
+    else if (*q < 0x20 || *q == 0x7f)
+      k += (size_t)snprintf(out + k, len - k, "\\x%02x", *q);
+    else
+      out[k++] = (char)*q;
+  }
+  out[k] = 0;
+}
+
+static void clear_progress(void) {
+  if (g_progress_shown) {
+    fputs("\r\033[K", stderr);
+    g_progress_shown = 0;
+  }
+}
+
+/* One line on stdout (and into run.log). */
 static void logline(const char *fmt, ...) {
-  char buf[2048];
+  char buf[2048], line[4096];
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(buf, sizeof buf, fmt, ap);
   va_end(ap);
-  printf("%s\n", buf);
+  one_line(buf, line, sizeof line);
+  clear_progress();
+  printf("%s\n", line);
   fflush(stdout);
   if (g_log) {
-    fprintf(g_log, "%s\n", buf);
+    fprintf(g_log, "%s\n", line);
     fflush(g_log);
   }
+}
+
+/* "rhod: message" on stderr, as one line. */
+static void report(const char *fmt, ...) {
+  char buf[4096], line[8192];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  one_line(buf, line, sizeof line);
+  clear_progress();
+  fprintf(stderr, "rhod: %s\n", line);
+  fflush(stderr);
 }
 
 static double now(void) {
@@ -56,6 +135,17 @@ static double now(void) {
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
+
+static void fmt_hms(double s, char *buf, size_t len) {
+  if (!isfinite(s) || s < 0)
+    s = 0;
+  if (s > 1e9)
+    s = 1e9;
+  long t = (long)(s + 0.5);
+  snprintf(buf, len, "%02ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+}
+
+/* ---- the output folder ---------------------------------------------------------------- */
 
 static int mkdir_p(const char *path) {
   char tmp[4096];
@@ -77,28 +167,188 @@ static int mkdir_p(const char *path) {
   return 0;
 }
 
-static int check_output_dir(const char *out, char *err, size_t len) {
+/* The default output folder: out/NAME, NAME the scene file's name without .yaml (.yml),
+ * or the name of its folder for a file called scene.yaml. Never "." or "..": the name is
+ * taken from the resolved path, and a name that is still not a plain one becomes
+ * "scene". */
+static void default_out(const char *scene, char *buf, size_t len) {
+  char tmp[4096];
+  char *abs = realpath(scene, NULL);
+  snprintf(tmp, sizeof tmp, "%s", abs ? abs : scene);
+  free(abs);
+  size_t l = strlen(tmp);
+  while (l > 1 && tmp[l - 1] == '/')
+    tmp[--l] = 0;
+  char *slash = strrchr(tmp, '/');
+  char *base = slash ? slash + 1 : tmp;
+  if ((!strcmp(base, "scene.yaml") || !strcmp(base, "scene.yml")) && slash && slash > tmp) {
+    *slash = 0;
+    char *s2 = strrchr(tmp, '/');
+    base = s2 ? s2 + 1 : tmp;
+  } else {
+    char *dot = strrchr(base, '.');
+    if (dot && dot != base && (!strcmp(dot, ".yaml") || !strcmp(dot, ".yml")))
+      *dot = 0;
+  }
+  if (!base[0] || base[0] == '.' || strchr(base, '/'))
+    base = "scene";
+  snprintf(buf, len, "out/%.1000s", base);
+}
+
+/* The files a run writes into its folder (what --overwrite removes): the snapshots and
+ * their pictures, the XDMF and walls files, probes.csv, summary.json, run.log,
+ * scene.yaml, checkpoint.rhod, and the .tmp names they are written under. */
+static int is_run_file(const char *name) {
+  static const char *const fixed[] = {"snapshots.xdmf", "walls.h5",        "walls.xdmf",
+                                      "probes.csv",     "summary.json",    "run.log",
+                                      "scene.yaml",     "checkpoint.rhod", ".rhod_write_test"};
+  char n[512];
+  snprintf(n, sizeof n, "%s", name);
+  size_t l = strlen(n);
+  if (l > 4 && !strcmp(n + l - 4, ".tmp"))
+    n[l -= 4] = 0;
+  for (size_t k = 0; k < sizeof fixed / sizeof fixed[0]; k++)
+    if (!strcmp(n, fixed[k]))
+      return 1;
+  if (strncmp(n, "snapshot_", 9) != 0)
+    return 0;
+  size_t d = 9;
+  while (n[d] >= '0' && n[d] <= '9')
+    d++;
+  return d >= 13 && (!strcmp(n + d, ".h5") || !strcmp(n + d, ".png"));
+}
+
+#define LOCK_NAME ".rhod.lock"
+
+/* Creates OUT, takes its lock (flock on OUT/.rhod.lock, held until the process ends:
+ * a second run into the same folder refuses, naming the first), checks that it can be
+ * written and, for a new run, that it holds no earlier run: without `overwrite` a folder
+ * with any file is refused; with it, the run files of the earlier run are removed. */
+static int prepare_output(const char *out, int resume, int overwrite, int *lockfd, char *err,
+                          size_t len) {
+  *lockfd = -1;
   if (mkdir_p(out) != 0) {
     snprintf(err, len, "%.900s: cannot create output folder: %s", out, strerror(errno));
     return RHOD_ERR_OUTPUT;
   }
-  char probe[4200];
-  snprintf(probe, sizeof probe, "%s/.rhod_write_test", out);
-  FILE *f = fopen(probe, "w");
+  char path[4200];
+  snprintf(path, sizeof path, "%s/" LOCK_NAME, out);
+  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0) {
+    snprintf(err, len, "%.900s: output folder is not writable: %s", out, strerror(errno));
+    return RHOD_ERR_OUTPUT;
+  }
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    char pid[32] = "";
+    ssize_t got = pread(fd, pid, sizeof pid - 1, 0);
+    pid[got > 0 ? got : 0] = 0;
+    pid[strcspn(pid, "\n")] = 0;
+    snprintf(err, len,
+             "%.900s: another rhod run (pid %s) is writing into this folder; wait for it or "
+             "choose another folder with -o",
+             out, pid[0] ? pid : "unknown");
+    close(fd);
+    return RHOD_ERR_OUTPUT;
+  }
+  char pid[32];
+  const int pl = snprintf(pid, sizeof pid, "%ld\n", (long)getpid());
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, pid, (size_t)pl, 0) != pl) {
+    snprintf(err, len, "%.900s: output folder is not writable: %s", out, strerror(errno));
+    close(fd);
+    return RHOD_ERR_OUTPUT;
+  }
+  *lockfd = fd;
+  snprintf(path, sizeof path, "%s/.rhod_write_test", out);
+  FILE *f = fopen(path, "w");
   if (!f || fputs("x", f) < 0 || fclose(f) != 0) {
     snprintf(err, len, "%.900s: output folder is not writable: %s", out, strerror(errno));
     return RHOD_ERR_OUTPUT;
   }
-  remove(probe);
+  remove(path);
+  if (resume)
+    return RHOD_OK;
+  DIR *d = opendir(out);
+  if (!d) {
+    snprintf(err, len, "%.900s: cannot list the output folder: %s", out, strerror(errno));
+    return RHOD_ERR_OUTPUT;
+  }
+  int others = 0, removed_fail = 0;
+  char first[256] = "";
+  struct dirent *e;
+  while ((e = readdir(d))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..") || !strcmp(e->d_name, LOCK_NAME))
+      continue;
+    if (!overwrite) {
+      if (!others++)
+        snprintf(first, sizeof first, "%.200s", e->d_name);
+      continue;
+    }
+    if (!is_run_file(e->d_name))
+      continue;
+    snprintf(path, sizeof path, "%s/%s", out, e->d_name);
+    if (unlink(path) != 0 && !removed_fail++)
+      snprintf(first, sizeof first, "%.200s: %.40s", e->d_name, strerror(errno));
+  }
+  closedir(d);
+  if (others) {
+    snprintf(err, len,
+             "%.700s: output folder is not empty (it holds %s%s): give --overwrite to replace "
+             "an earlier run's files, or choose another folder with -o",
+             out, first, others > 1 ? " and more" : "");
+    return RHOD_ERR_OUTPUT;
+  }
+  if (removed_fail) {
+    snprintf(err, len, "%.900s: --overwrite cannot remove %s", out, first);
+    return RHOD_ERR_OUTPUT;
+  }
   return RHOD_OK;
 }
 
-static void fmt_hms(double s, char *buf, size_t len) {
-  if (!isfinite(s) || s < 0)
-    s = 0;
-  long t = (long)(s + 0.5);
-  snprintf(buf, len, "%02ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+/* A resume appends to the output of the checkpoint's run: every snapshot the checkpoint
+ * lists must be that run's (its time and particle count; a missing one is only reported)
+ * and probes.csv at least as long as at the checkpoint. Nothing is written here. */
+static int check_resume_files(const char *out, const rhod_checkpoint *ck, int *missing, char *err,
+                              size_t len) {
+  char path[4200];
+  *missing = 0;
+  snprintf(path, sizeof path, "%s/probes.csv", out);
+  struct stat st;
+  if (stat(path, &st) != 0 || !S_ISREG(st.st_mode)) {
+    snprintf(err, len, "%.900s: missing or not a file: the checkpoint's run wrote it", path);
+    return RHOD_ERR_CHECKPOINT;
+  }
+  if ((uint64_t)st.st_size < ck->probes_bytes) {
+    snprintf(err, len,
+             "%.900s: %lld bytes, shorter than the %llu the checkpoint recorded: it is not the "
+             "checkpoint's run's file",
+             path, (long long)st.st_size, (unsigned long long)ck->probes_bytes);
+    return RHOD_ERR_CHECKPOINT;
+  }
+  for (int i = 0; i < ck->nsnap; i++) {
+    snprintf(path, sizeof path, "%s/snapshot_%04d.h5", out, i);
+    if (access(path, F_OK) != 0) {
+      (*missing)++;
+      continue;
+    }
+    double t = 0;
+    uint64_t n = 0;
+    char e2[ERRLEN];
+    if (rhod_read_snapshot_header(path, &t, &n, e2, sizeof e2) != RHOD_OK) {
+      snprintf(err, len, "%.900s (resume)", e2);
+      return RHOD_ERR_CHECKPOINT;
+    }
+    if (t != ck->snap_t[i] || n != ck->snap_n[i]) {
+      snprintf(err, len,
+               "%.700s: t = %.9g s with %llu particles, but the checkpoint's run wrote t = %.9g "
+               "s with %llu: the folder holds another run's files",
+               path, t, (unsigned long long)n, ck->snap_t[i], (unsigned long long)ck->snap_n[i]);
+      return RHOD_ERR_CHECKPOINT;
+    }
+  }
+  return RHOD_OK;
 }
+
+/* ---- the run -------------------------------------------------------------------------- */
 
 typedef struct {
   const char *out;
@@ -167,7 +417,10 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   rhod_sim *s = &c->sim;
   rhod_snapshot_view v;
   rhod_sim_fetch(s, &v);
-  int st = rhod_write_snapshot(c->out, c->nsnap, &v, &c->params, err, len);
+  int st = rhod_snapshot_check(&v, err, len);
+  if (st != RHOD_OK)
+    return st;
+  st = rhod_write_snapshot(c->out, c->nsnap, &v, &c->params, err, len);
   if (st != RHOD_OK)
     return st;
   if (c->nsnap >= c->snap_cap) {
@@ -193,135 +446,151 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   return st;
 }
 
+/* A number for JSON: null when not finite (JSON has no inf or NaN). */
+static json_t *jnum(double v) { return isfinite(v) ? json_real(v) : json_null(); }
+
+/* A string for JSON: as it is when it is UTF-8, else with each byte above 0x7f as '?'. */
+static json_t *jstr(const char *v) {
+  json_t *j = json_string(v ? v : "");
+  if (j)
+    return j;
+  char *a = strdup(v);
+  for (char *q = a; q && *q; q++)
+    if ((unsigned char)*q > 0x7f)
+      *q = '?';
+  j = json_string(a ? a : "");
+  free(a);
+  return j;
+}
+
 static int write_summary(run_ctx *c, const char *status, const char *cause, double wall) {
   rhod_sim *s = &c->sim;
-  char buf[16384];
-  size_t o = 0;
   const double psteps = s->particle_steps;
-  o += (size_t)snprintf(buf + o, sizeof buf - o,
-                        "{\n  \"status\": \"%s\",\n  \"cause\": \"%s\",\n  \"scene\": \"%s\",\n"
-                        "  \"particles\": %zu,\n  \"steps\": %ld,\n  \"time\": %.9g,\n"
-                        "  \"dt\": %.9g,\n  \"wall_seconds\": %.6g,\n"
-                        "  \"us_per_particle_step\": %.6g,\n  \"precision\": \"%s\",\n"
-                        "  \"threads\": %d,\n  \"kernels_ran_on\": \"%s\",\n"
-                        "  \"wall_reflections\": %ld,\n  \"splits\": %ld,\n  \"merges\": %ld,\n"
-                        "  \"absorbed\": %ld,\n  \"merge_dissipation\": %.9g,\n"
-                        "  \"absorb_dissipation\": %.9g,\n"
-                        "  \"damper_limited_steps\": %ld,\n  \"stiffness_limited_steps\": %ld,\n"
-                        "  \"probes\": {",
-                        status, cause, c->sc->path, s->p.n, s->step, s->t, s->dt, wall,
-                        psteps > 0 ? 1e6 * wall / psteps : 0.0, RHOD_REAL_NAME,
-                        omp_get_max_threads(), c->where, s->reflected, s->apr.split_total,
-                        s->apr.merged_total, s->apr.absorbed_total, s->apr.ke_merged,
-                        s->apr.ke_absorbed, s->damper_limited, s->stiffness_limited);
-  for (unsigned k = 0; k < c->nprobe_cols && o < sizeof buf - 200; k++)
-    o += (size_t)snprintf(buf + o, sizeof buf - o, "%s\n    \"%s\": %.9g", k ? "," : "",
-                          c->probe_names[k], c->probe_vals ? c->probe_vals[k] : 0.0);
-  o += (size_t)snprintf(buf + o, sizeof buf - o, "%s}\n}\n", c->nprobe_cols ? "\n  " : "");
+  json_t *probes = json_object();
+  for (unsigned k = 0; probes && k < c->nprobe_cols; k++)
+    json_object_set_new(probes, c->probe_names[k], jnum(c->probe_vals ? c->probe_vals[k] : 0.0));
+  json_t *o = json_object();
+  if (o) {
+    json_object_set_new(o, "status", jstr(status));
+    json_object_set_new(o, "cause", jstr(cause));
+    json_object_set_new(o, "scene", jstr(c->sc->path));
+    json_object_set_new(o, "particles", json_integer((json_int_t)s->p.n));
+    json_object_set_new(o, "steps", json_integer(s->step));
+    json_object_set_new(o, "time", jnum(s->t));
+    json_object_set_new(o, "dt", jnum(s->dt));
+    json_object_set_new(o, "wall_seconds", jnum(wall));
+    json_object_set_new(o, "us_per_particle_step", jnum(psteps > 0 ? 1e6 * wall / psteps : 0.0));
+    json_object_set_new(o, "precision", json_string(RHOD_REAL_NAME));
+    json_object_set_new(o, "threads", json_integer(omp_get_max_threads()));
+    json_object_set_new(o, "kernels_ran_on", jstr(c->where));
+    json_object_set_new(o, "wall_reflections", json_integer(s->reflected));
+    json_object_set_new(o, "splits", json_integer(s->apr.split_total));
+    json_object_set_new(o, "merges", json_integer(s->apr.merged_total));
+    json_object_set_new(o, "absorbed", json_integer(s->apr.absorbed_total));
+    json_object_set_new(o, "merge_dissipation", jnum(s->apr.ke_merged));
+    json_object_set_new(o, "absorb_dissipation", jnum(s->apr.ke_absorbed));
+    json_object_set_new(o, "damper_limited_steps", json_integer(s->damper_limited));
+    json_object_set_new(o, "stiffness_limited_steps", json_integer(s->stiffness_limited));
+    json_object_set_new(o, "probes", probes ? probes : json_null());
+  }
+  char *text =
+      o ? json_dumps(o, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(9)) : NULL;
+  json_decref(o);
   char path[4200], err[ERRLEN];
   snprintf(path, sizeof path, "%s/summary.json", c->out);
-  int st = rhod_write_file_atomic(path, buf, err, sizeof err);
+  int st;
+  if (!text) {
+    snprintf(err, sizeof err, "%.900s: cannot write: out of memory (or text that is not UTF-8)",
+             path);
+    st = RHOD_ERR_MEMORY;
+  } else {
+    const size_t l = strlen(text);
+    char *nl = realloc(text, l + 2);
+    if (nl)
+      text = nl, text[l] = '\n', text[l + 1] = 0;
+    st = rhod_write_file_atomic(path, text, err, sizeof err);
+    free(text);
+  }
   if (st != RHOD_OK)
-    fprintf(stderr, "rhod: %s\n", err);
+    report("%s", err);
   return st;
 }
 
-static int cmd_run(int argc, char **argv, const char *resume_out) {
-  const char *scene = NULL, *out = NULL;
-  const char *sets[256];
-  int nsets = 0;
-  double ck_every = 0;
+typedef struct {
+  const char *scene;
+  const char *out;
+  const char *sets[MAX_SETS];
+  int nsets;
+  double ck_every;
+  int overwrite;
+} run_opts;
+
+static void install_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART; /* no SA_RESETHAND: a second signal is caught too */
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
+
+static void default_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = SIG_DFL;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
+
+static int run(run_opts *o, const char *resume_out) {
   rhod_checkpoint ck;
   memset(&ck, 0, sizeof ck);
   char err[ERRLEN] = "";
+  int lockfd = -1;
   if (resume_out) {
     char path[4200];
     snprintf(path, sizeof path, "%s/checkpoint.rhod", resume_out);
     int st = rhod_checkpoint_read(path, &ck, err, sizeof err);
+    if (st == RHOD_OK && (ck.nsets < 0 || ck.nsets > MAX_SETS)) {
+      snprintf(err, sizeof err, "%.900s: %d overrides, more than the %d a run takes", path,
+               (int)ck.nsets, MAX_SETS);
+      st = RHOD_ERR_CHECKPOINT;
+    }
     if (st != RHOD_OK) {
-      fprintf(stderr, "rhod: %s\n", err);
+      report("%s", err);
+      rhod_checkpoint_free(&ck);
       return st;
     }
-    scene = ck.scene_path;
-    out = resume_out;
-    nsets = ck.nsets < 256 ? ck.nsets : 256;
-    for (int i = 0; i < nsets; i++)
-      sets[i] = ck.sets[i];
-    ck_every = ck.checkpoint_every;
+    o->scene = ck.scene_path;
+    o->out = resume_out;
+    o->nsets = ck.nsets;
+    for (int i = 0; i < o->nsets; i++)
+      o->sets[i] = ck.sets[i];
+    o->ck_every = ck.checkpoint_every;
   }
-  for (int i = 0; i < argc; i++) {
-    if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
-      if (++i >= argc) {
-        fprintf(stderr, "rhod: -o needs a folder\n%s", USAGE);
-        return RHOD_ERR_USAGE;
-      }
-      out = argv[i];
-    } else if (!strcmp(argv[i], "--set")) {
-      if (++i >= argc || !strchr(argv[i], '=')) {
-        fprintf(stderr, "rhod: --set needs dotted.key=value\n%s", USAGE);
-        return RHOD_ERR_USAGE;
-      }
-      if (nsets >= 256) {
-        fprintf(stderr, "rhod: too many --set options (256 at most)\n");
-        return RHOD_ERR_USAGE;
-      }
-      sets[nsets++] = argv[i];
-    } else if (!strcmp(argv[i], "--checkpoint-every")) {
-      char *end = NULL;
-      ck_every = ++i < argc ? strtod(argv[i], &end) : 0;
-      if (i >= argc || !end || *end || !(ck_every > 0) || !isfinite(ck_every)) {
-        fprintf(stderr, "rhod: --checkpoint-every needs a time in seconds > 0\n%s", USAGE);
-        return RHOD_ERR_USAGE;
-      }
-    } else if (!strncmp(argv[i], "--set=", 6)) {
-      if (nsets < 256)
-        sets[nsets++] = argv[i] + 6;
-    } else if (argv[i][0] == '-') {
-      fprintf(stderr, "rhod: unknown option '%s'\n%s", argv[i], USAGE);
-      return RHOD_ERR_USAGE;
-    } else if (!scene) {
-      scene = argv[i];
-    } else {
-      fprintf(stderr, "rhod: one scene per run ('%s' is extra)\n%s", argv[i], USAGE);
-      return RHOD_ERR_USAGE;
-    }
-  }
-  if (!scene) {
-    fprintf(stderr, "rhod: run needs a scene file\n%s", USAGE);
-    return RHOD_ERR_USAGE;
-  }
+  const char *scene = o->scene;
   run_ctx c;
   memset(&c, 0, sizeof c);
   /* the checkpoint keeps the scene's absolute path, so a resume works from anywhere */
   char scene_abs[4096];
   c.scene_arg = !resume_out && realpath(scene, scene_abs) ? scene_abs : scene;
-  c.sets = sets;
-  c.nsets = nsets;
-  c.ck_every = ck_every;
-  int st = rhod_scene_load(scene, sets, nsets, &c.sc, err, sizeof err);
+  c.sets = o->sets;
+  c.nsets = o->nsets;
+  c.ck_every = o->ck_every;
+  int st = rhod_scene_load(scene, o->sets, o->nsets, &c.sc, err, sizeof err);
   if (st != RHOD_OK) {
-    fprintf(stderr, "rhod: %s\n", err);
+    report("%s", err);
     rhod_checkpoint_free(&ck);
     return st;
   }
   char outbuf[4096];
-  if (!out) {
-    /* default: out/<name of the scene's folder, or the file without .yaml> */
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s", scene);
-    char *slash = strrchr(tmp, '/');
-    const char *base = slash ? slash + 1 : tmp;
-    if (!strcmp(base, "scene.yaml") && slash) {
-      *slash = 0;
-      char *s2 = strrchr(tmp, '/');
-      base = s2 ? s2 + 1 : tmp;
-    }
-    snprintf(outbuf, sizeof outbuf, "out/%.1000s", base);
-    char *dot = strrchr(outbuf, '.');
-    if (dot && !strcmp(dot, ".yaml"))
-      *dot = 0;
-    out = outbuf;
+  if (!o->out) {
+    default_out(scene, outbuf, sizeof outbuf);
+    o->out = outbuf;
   }
+  const char *out = o->out;
   c.out = out;
   char warn[4096];
   const int nw = rhod_scene_warnings(c.sc, warn, sizeof warn);
@@ -361,28 +630,85 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
         snprintf(err, sizeof err, "out of memory for ghost particles");
     }
   }
+  /* the state that will be written first, checked before anything is written */
+  if (st == RHOD_OK) {
+    rhod_snapshot_view v;
+    rhod_sim_fetch(&c.sim, &v);
+    st = rhod_snapshot_check(&v, err, sizeof err);
+    if (st == RHOD_OK && !(isfinite(c.sim.dt) && c.sim.dt > 0)) {
+      snprintf(err, sizeof err,
+               "unstable at t = %.6g s: the time step is %g s, not finite and positive (check "
+               "the speed of sound, densities and gravity); nothing was written",
+               c.sim.t, c.sim.dt);
+      st = RHOD_ERR_UNSTABLE;
+    }
+  }
+  int missing = 0;
   if (st == RHOD_OK)
-    st = check_output_dir(out, err, sizeof err);
+    st = prepare_output(out, resume_out != NULL, o->overwrite, &lockfd, err, sizeof err);
+  if (st == RHOD_OK && resume_out)
+    st = check_resume_files(out, &ck, &missing, err, sizeof err);
   if (st != RHOD_OK) {
-    fprintf(stderr, "rhod: %s\n", err);
+    report("%s", err);
     rhod_sim_free(&c.sim);
     rhod_scene_free(c.sc);
     rhod_checkpoint_free(&ck);
+    if (lockfd >= 0)
+      close(lockfd);
     return st;
   }
+  rhod_scene_params(c.sc, &c.params);
+  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, RHOD_PROBE_COLUMNS_TOTAL);
+  c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
   char path[4200];
+  snprintf(path, sizeof path, "%s/probes.csv", out);
+  /* probes.csv first: a resume whose probes do not fit stops before run.log grows */
+  if (resume_out)
+    st = rhod_csv_reopen(&c.csv, path, c.nprobe_cols, ck.probes_bytes, err, sizeof err);
+  else
+    st = rhod_csv_open(&c.csv, path, c.nprobe_cols, c.probe_names, err, sizeof err);
+  if (st != RHOD_OK) {
+    report("%s", err);
+    free(c.probe_vals);
+    rhod_param_list_free(&c.params);
+    rhod_sim_free(&c.sim);
+    rhod_scene_free(c.sc);
+    rhod_checkpoint_free(&ck);
+    close(lockfd);
+    return st;
+  }
+  c.csv_open = 1;
+  const double t0 = now();
   snprintf(path, sizeof path, "%s/run.log", out);
   g_log = fopen(path, resume_out ? "a" : "w");
   if (!g_log) {
-    fprintf(stderr, "rhod: %s: cannot write: %s\n", path, strerror(errno));
-    rhod_sim_free(&c.sim);
-    rhod_scene_free(c.sc);
-    rhod_checkpoint_free(&ck);
-    return RHOD_ERR_OUTPUT;
+    snprintf(err, sizeof err, "%.900s: cannot write: %s", path, strerror(errno));
+    st = RHOD_ERR_OUTPUT;
+    goto fail;
+  }
+  if (!resume_out) {
+    /* the scene as run: `rhod run OUT/scene.yaml` repeats the run */
+    snprintf(path, sizeof path, "%s/scene.yaml", out);
+    char head[8192];
+    snprintf(head, sizeof head,
+             "# The scene as run by rhod: %s with every default filled in%s.\n# rhod run "
+             "OUT/scene.yaml repeats the run.\n",
+             c.sc->path, o->nsets ? " and its --set overrides applied" : "");
+    char *text = malloc(strlen(head) + strlen(c.sc->yaml) + 1);
+    if (!text) {
+      st = RHOD_ERR_MEMORY;
+      snprintf(err, sizeof err, "out of memory");
+      goto fail;
+    }
+    strcpy(text, head);
+    strcat(text, c.sc->yaml);
+    st = rhod_write_file_atomic(path, text, err, sizeof err);
+    free(text);
+    if (st != RHOD_OK)
+      goto fail;
   }
   rhod_where(c.where, sizeof c.where);
   rhod_sim *s = &c.sim;
-  const double t0 = now();
   c.step0 = s->step;
   const int tty = isatty(2);
   if (resume_out)
@@ -403,21 +729,14 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       line = strtok(NULL, "\n");
     }
   }
-  rhod_scene_params(c.sc, &c.params);
-  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, RHOD_PROBE_COLUMNS_TOTAL);
-  c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
-  snprintf(path, sizeof path, "%s/probes.csv", out);
-  if (resume_out)
-    st = rhod_csv_reopen(&c.csv, path, c.nprobe_cols, ck.probes_bytes, err, sizeof err);
-  else
-    st = rhod_csv_open(&c.csv, path, c.nprobe_cols, c.probe_names, err, sizeof err);
-  if (st != RHOD_OK)
-    goto fail;
-  c.csv_open = 1;
+  if (missing)
+    logline("rhod: warning: %d of the %d snapshots the checkpoint lists are missing from %s; "
+            "snapshots.xdmf still names them",
+            missing, (int)ck.nsnap, out);
 
   const double t_end = c.sc->t_end, dout = c.sc->output_every, dprobe = c.sc->probe_every;
   double next_out = 0, next_probe = 0;
-  c.next_ck = ck_every;
+  c.next_ck = o->ck_every;
   if (resume_out) {
     next_out = ck.next_out, next_probe = ck.next_probe, c.next_ck = ck.next_checkpoint;
     c.snap_cap = ck.nsnap + 16;
@@ -433,34 +752,39 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     c.nsnap = ck.nsnap;
   }
   g_stop = 0;
-  signal(SIGINT, on_signal);
-  signal(SIGTERM, on_signal);
+  install_signals();
   double last_progress = -1;
   int last_decile = -1;
-  const double eps = 1e-9 * t_end;
   for (;;) {
-    const int done = s->t >= t_end - eps;
-    if (s->t >= next_probe - eps || done) {
+    const int done = rhod_schedule_reached(s->t, t_end, dout);
+    if (rhod_schedule_reached(s->t, next_probe, dprobe) || done) {
       rhod_probe_values(s, c.probe_vals);
+      for (unsigned k = 0; k < c.nprobe_cols; k++)
+        if (!isfinite(c.probe_vals[k])) {
+          snprintf(err, sizeof err,
+                   "unstable at t = %.6g s: probe column %s is not finite (%g); nothing was "
+                   "written for this time",
+                   s->t, c.probe_names[k], c.probe_vals[k]);
+          st = RHOD_ERR_UNSTABLE;
+          goto fail;
+        }
       st = rhod_csv_row(&c.csv, s->t, c.probe_vals, err, sizeof err);
       if (st != RHOD_OK)
         goto fail;
-      while (next_probe <= s->t + eps)
-        next_probe += dprobe;
+      next_probe = rhod_schedule_advance(next_probe, dprobe, s->t);
     }
-    if (s->t >= next_out - eps || done) {
+    if (rhod_schedule_reached(s->t, next_out, dout) || done) {
       st = write_output(&c, err, sizeof err);
       if (st != RHOD_OK)
         goto fail;
       logline("rhod: t = %.6g s: snapshot %d (%zu particles)", s->t, c.nsnap - 1, s->p.n);
-      while (next_out <= s->t + eps)
-        next_out += dout;
+      next_out = rhod_schedule_advance(next_out, dout, s->t);
     }
     if (done)
       break;
-    if ((c.ck_every > 0 && s->t >= c.next_ck - eps) || g_stop) {
-      while (c.ck_every > 0 && c.next_ck <= s->t + eps)
-        c.next_ck += c.ck_every;
+    if ((c.ck_every > 0 && rhod_schedule_reached(s->t, c.next_ck, c.ck_every)) || g_stop) {
+      if (c.ck_every > 0)
+        c.next_ck = rhod_schedule_advance(c.next_ck, c.ck_every, s->t);
       st = write_checkpoint(&c, next_out, next_probe, err, sizeof err);
       if (st != RHOD_OK)
         goto fail;
@@ -478,12 +802,23 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       goto fail;
     }
     double dt = s->dt;
-    /* land exactly on output times and on the end */
+    /* land exactly on output times and on the end: a step that would end within a
+     * millionth of itself before the target is stretched onto it, and one that would end
+     * less than a step before it is halved (tolerances relative to the step, not to the
+     * end time) */
     const double stop = fmin(t_end, next_out);
-    if (s->t + dt > stop - eps)
+    if (s->t + dt > stop - 1e-6 * dt)
       dt = stop - s->t;
     else if (s->t + 2 * dt > stop)
       dt = 0.5 * (stop - s->t);
+    if (!(s->t + dt > s->t)) {
+      snprintf(err, sizeof err,
+               "the time step %g s is below the resolution of t = %.17g s in double precision: "
+               "the run cannot advance (time.end too large against the step?)",
+               dt, s->t);
+      st = RHOD_ERR_UNSTABLE;
+      goto fail;
+    }
     st = rhod_sim_step(s, dt, err, sizeof err);
     if (st != RHOD_OK)
       goto fail;
@@ -501,13 +836,13 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       fmt_hms(frac > 0 ? w * (1 - frac) / frac : 0, eta, sizeof eta);
       fprintf(stderr,
               "%st = %.5g s  %5.1f%%  N = %zu  dt = %.3g s  %.3g particle-steps/s  ETA %s%s",
-              tty ? "\r" : "", s->t, 100 * frac, s->p.n, s->dt, s->particle_steps / (w > 0 ? w : 1),
-              eta, tty ? "   " : "\n");
+              tty ? "\r\033[K" : "", s->t, 100 * frac, s->p.n, s->dt,
+              s->particle_steps / (w > 0 ? w : 1), eta, tty ? "" : "\n");
       fflush(stderr);
+      g_progress_shown = tty;
     }
   }
-  if (tty)
-    fprintf(stderr, "\n");
+  clear_progress();
   {
     const double wall = now() - t0;
     const double psteps = s->particle_steps;
@@ -537,33 +872,24 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
   }
   goto cleanup;
 fail:
-  if (tty)
-    fprintf(stderr, "\n");
-  fprintf(stderr, "rhod: %s\n", err);
+  report("%s", err);
   if (g_log) {
-    fprintf(g_log, "rhod: error: %s\n", err);
+    char line[2 * ERRLEN];
+    one_line(err, line, sizeof line);
+    fprintf(g_log, "rhod: error: %s\n", line);
     fflush(g_log);
   }
-  {
-    char cause[ERRLEN];
-    size_t k = 0;
-    for (const char *q = err; *q && k < sizeof cause - 2; q++)
-      if (*q != '"' && *q != '\\')
-        cause[k++] = *q;
-    cause[k] = 0;
-    write_summary(&c, st == RHOD_ERR_UNSTABLE ? "unstable" : "error", cause, now() - t0);
-    if (st == RHOD_ERR_UNSTABLE)
-      fprintf(stderr, "rhod: the last good snapshot is %s/snapshot_%04d.h5 (t = %g s)\n", out,
-              c.nsnap - 1, c.nsnap ? c.snap_t[c.nsnap - 1] : 0.0);
-  }
+  write_summary(&c, st == RHOD_ERR_UNSTABLE ? "unstable" : "error", err, now() - t0);
+  if (st == RHOD_ERR_UNSTABLE && c.nsnap)
+    report("the last good snapshot is %s/snapshot_%04d.h5 (t = %g s)", out, c.nsnap - 1,
+           c.snap_t[c.nsnap - 1]);
 cleanup:
-  signal(SIGINT, SIG_DFL);
-  signal(SIGTERM, SIG_DFL);
+  default_signals();
   rhod_checkpoint_free(&ck);
   if (c.csv_open) {
     char e2[ERRLEN];
     if (rhod_csv_close(&c.csv, e2, sizeof e2) != RHOD_OK && st == RHOD_OK) {
-      fprintf(stderr, "rhod: %s\n", e2);
+      report("%s", e2);
       st = RHOD_ERR_IO;
     }
   }
@@ -576,15 +902,201 @@ cleanup:
   free(c.probe_vals);
   rhod_sim_free(&c.sim);
   rhod_scene_free(c.sc);
+  if (lockfd >= 0)
+    close(lockfd);
   return st;
 }
 
-int main(int argc, char **argv) {
-  if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
-    fputs(USAGE, argc < 2 ? stderr : stdout);
-    return argc < 2 ? RHOD_ERR_USAGE : 0;
+/* ---- rhod check ----------------------------------------------------------------------- */
+
+static int check_scene(run_opts *o) {
+  char err[ERRLEN] = "";
+  rhod_scene *sc = NULL;
+  int st = rhod_scene_load(o->scene, o->sets, o->nsets, &sc, err, sizeof err);
+  if (st != RHOD_OK) {
+    report("%s", err);
+    return st;
   }
-  if (!strcmp(argv[1], "--version")) {
+  char warn[4096];
+  const int nw = rhod_scene_warnings(sc, warn, sizeof warn);
+  rhod_sim sim;
+  memset(&sim, 0, sizeof sim);
+  st = rhod_sim_init(&sim, sc, err, sizeof err);
+  if (st == RHOD_OK) {
+    rhod_snapshot_view v;
+    rhod_sim_fetch(&sim, &v);
+    st = rhod_snapshot_check(&v, err, sizeof err);
+  }
+  if (st != RHOD_OK) {
+    report("%s", err);
+    rhod_sim_free(&sim);
+    rhod_scene_free(sc);
+    return st;
+  }
+  size_t per = 0;
+  for (int k = 0; k < sim.p.nfields; k++)
+    per += sim.p.fields[k].elem;
+  const double bytes = (double)per * (double)sim.p.cap;
+  printf("scene: %s\n", sc->path);
+  printf("particles: %zu fluid (%d level%s, dx = %g m), %zu ghosts at t = 0\n", sim.p.n, sc->levels,
+         sc->levels > 1 ? "s" : "", sc->dx, sim.p.ng);
+  printf("memory: %.1f MiB for the particle arrays (%zu bytes per particle, room for %zu)\n",
+         bytes / 1048576.0, per, sim.p.cap);
+  printf("first time step: %.4g s\n", sim.dt);
+  const double steps = sim.dt > 0 ? sc->t_end / sim.dt : 0;
+  printf("steps: about %.0f to t = %g s at the first step's size (the step changes with the "
+         "flow)\n",
+         ceil(steps), sc->t_end);
+  printf("outputs: %.0f snapshots, %.0f probe rows\n", floor(sc->t_end / sc->output_every) + 1,
+         floor(sc->t_end / sc->probe_every) + 1);
+  if (nw > 0) {
+    char *line = strtok(warn, "\n");
+    while (line) {
+      printf("warning: %s\n", line);
+      line = strtok(NULL, "\n");
+    }
+  }
+  rhod_sim_free(&sim);
+  rhod_scene_free(sc);
+  return RHOD_OK;
+}
+
+/* ---- the command line ----------------------------------------------------------------- */
+
+enum { OPT_SET = 256, OPT_CHECKPOINT, OPT_OVERWRITE };
+
+/* Parses the options of run (command 0) or check (command 2); *help set on -h. */
+static int parse_opts(int argc, char **argv, int command, run_opts *o, int *help) {
+  static const struct option run_long[] = {
+      {"output", required_argument, NULL, 'o'},
+      {"set", required_argument, NULL, OPT_SET},
+      {"checkpoint-every", required_argument, NULL, OPT_CHECKPOINT},
+      {"overwrite", no_argument, NULL, OPT_OVERWRITE},
+      {"help", no_argument, NULL, 'h'},
+      {NULL, 0, NULL, 0}};
+  static const struct option check_long[] = {{"set", required_argument, NULL, OPT_SET},
+                                             {"help", no_argument, NULL, 'h'},
+                                             {NULL, 0, NULL, 0}};
+  const int is_run = command == 0;
+  const char *name = is_run ? "run" : "check";
+  optind = 0; /* a fresh scan */
+  opterr = 0;
+  *help = 0;
+  int ch;
+  while ((ch = getopt_long(argc, argv, is_run ? ":o:h" : ":h", is_run ? run_long : check_long,
+                           NULL)) != -1) {
+    switch (ch) {
+    case 'o':
+      o->out = optarg;
+      break;
+    case OPT_SET:
+      if (!strchr(optarg, '=') || optarg[0] == '=') {
+        report("%s: --set needs dotted.key=value (got '%.200s')", name, optarg);
+        return RHOD_ERR_USAGE;
+      }
+      if (o->nsets >= MAX_SETS) {
+        report("%s: too many --set options (%d at most)", name, MAX_SETS);
+        return RHOD_ERR_USAGE;
+      }
+      o->sets[o->nsets++] = optarg;
+      break;
+    case OPT_CHECKPOINT: {
+      char *end = NULL;
+      o->ck_every = strtod(optarg, &end);
+      if (!end || *end || end == optarg || !(o->ck_every > 0) || !isfinite(o->ck_every)) {
+        report("run: --checkpoint-every needs a time in seconds > 0 (got '%.200s')", optarg);
+        return RHOD_ERR_USAGE;
+      }
+      break;
+    }
+    case OPT_OVERWRITE:
+      o->overwrite = 1;
+      break;
+    case 'h':
+      *help = 1;
+      return RHOD_OK;
+    case ':':
+      report("%s: option '%s' needs a value (rhod help %s)", name, argv[optind - 1], name);
+      return RHOD_ERR_USAGE;
+    default:
+      report("%s: unknown option '%s' (rhod help %s)", name, argv[optind - 1], name);
+      return RHOD_ERR_USAGE;
+    }
+  }
+  /* GNU getopt_long moves the operands behind the options: the scene, and nothing else */
+  if (optind < argc)
+    o->scene = argv[optind++];
+  if (optind < argc) {
+    report("%s: one scene per %s ('%s' is extra)", name, name, argv[optind]);
+    return RHOD_ERR_USAGE;
+  }
+  return RHOD_OK;
+}
+
+static int usage_error(const char *msg) {
+  report("%s", msg);
+  fputs(USAGE, stderr);
+  return RHOD_ERR_USAGE;
+}
+
+static int cmd_help(const char *topic) {
+  if (!topic) {
+    fputs(USAGE, stdout);
+    fputs("Commands:\n  run      runs a scene (rhod help run)\n"
+          "  resume   continues a run from its checkpoint (rhod help resume)\n"
+          "  check    validates a scene and estimates the run, writing nothing (rhod help "
+          "check)\n",
+          stdout);
+    return 0;
+  }
+  if (!strcmp(topic, "run"))
+    fputs(HELP_RUN, stdout);
+  else if (!strcmp(topic, "resume"))
+    fputs(HELP_RESUME, stdout);
+  else if (!strcmp(topic, "check"))
+    fputs(HELP_CHECK, stdout);
+  else {
+    report("help: no command '%s' (run, resume, check)", topic);
+    return RHOD_ERR_USAGE;
+  }
+  return 0;
+}
+
+/* File descriptors 0, 1 and 2 open (on /dev/null when the caller closed them): a file
+ * the run opens must never become stdout or stderr and receive the terminal output. */
+static void keep_std_fds(void) {
+  for (int fd = 0; fd < 3; fd++)
+    if (fcntl(fd, F_GETFD) < 0 && errno == EBADF) {
+      int n = open("/dev/null", O_RDWR);
+      if (n >= 0 && n != fd) {
+        dup2(n, fd);
+        close(n);
+      }
+    }
+}
+
+int main(int argc, char **argv) {
+  keep_std_fds();
+  /* a closed pipe on stdout or stderr (rhod run ... | head) must not kill the run */
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = SIG_IGN;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGPIPE, &sa, NULL);
+
+  if (argc < 2) {
+    fputs(USAGE, stderr);
+    return RHOD_ERR_USAGE;
+  }
+  const char *cmd = argv[1];
+  if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h"))
+    return cmd_help(NULL);
+  if (!strcmp(cmd, "help")) {
+    if (argc > 3)
+      return usage_error("help: one command at most");
+    return cmd_help(argc == 3 ? argv[2] : NULL);
+  }
+  if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
     printf("rhod 0.1 (%s precision, %s)\n", RHOD_REAL_NAME,
 #ifdef RHOD_OFFLOAD
            "nvptx offload"
@@ -594,15 +1106,28 @@ int main(int argc, char **argv) {
     );
     return 0;
   }
-  if (!strcmp(argv[1], "run"))
-    return cmd_run(argc - 2, argv + 2, NULL);
-  if (!strcmp(argv[1], "resume")) {
-    if (argc != 3) {
-      fprintf(stderr, "rhod: resume needs exactly one output folder\n%s", USAGE);
-      return RHOD_ERR_USAGE;
-    }
-    return cmd_run(0, NULL, argv[2]);
+  static run_opts o; /* static: 256 override pointers */
+  memset(&o, 0, sizeof o);
+  if (!strcmp(cmd, "run") || !strcmp(cmd, "check")) {
+    const int is_run = !strcmp(cmd, "run");
+    int help = 0;
+    int st = parse_opts(argc - 1, argv + 1, is_run ? 0 : 2, &o, &help);
+    if (st != RHOD_OK)
+      return st;
+    if (help)
+      return cmd_help(cmd);
+    if (!o.scene)
+      return usage_error(is_run ? "run needs a scene file" : "check needs a scene file");
+    return is_run ? run(&o, NULL) : check_scene(&o);
   }
-  fprintf(stderr, "rhod: unknown command '%s'\n%s", argv[1], USAGE);
+  if (!strcmp(cmd, "resume")) {
+    if (argc == 3 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h")))
+      return cmd_help("resume");
+    if (argc != 3 || argv[2][0] == '-')
+      return usage_error("resume needs exactly one output folder (rhod help resume)");
+    return run(&o, argv[2]);
+  }
+  report("unknown command '%s'", cmd);
+  fputs(USAGE, stderr);
   return RHOD_ERR_USAGE;
 }

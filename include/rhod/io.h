@@ -24,6 +24,11 @@ typedef struct {
   const uint8_t *fs;   /* free-surface flag (1: in F), may be NULL */
 } rhod_snapshot_view;
 
+/* Checks every value of v before it is written: positions, velocities and pressures
+ * finite, masses, densities and sizes finite and positive. Errors: RHOD_ERR_UNSTABLE
+ * naming the particle, the field and the time. */
+int rhod_snapshot_check(const rhod_snapshot_view *v, char *err, size_t errlen);
+
 /* OUT/snapshot_NNNN.h5: /Header attrs Time, Dimension (2), NumPart; /PartType0 datasets
  * Coordinates, Velocities (N x 3, z = 0), Densities, Pressures, Masses, ParticleSizes,
  * ParticleIDs, FreeSurface (if fs); /Parameters string attributes (dotted keys). Plain
@@ -48,6 +53,10 @@ typedef struct {
 } rhod_snapshot_data;
 int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen);
 void rhod_snapshot_data_free(rhod_snapshot_data *d);
+/* Reads only /Header's Time and NumPart of a snapshot (a resume checks the snapshots it
+ * continues). Errors: RHOD_ERR_READ ("path: reason"). */
+int rhod_read_snapshot_header(const char *path, double *time, uint64_t *n, char *err,
+                              size_t errlen);
 
 /* OUT/snapshots.xdmf: a temporal collection of every snapshot written so far, as a
  * Polyvertex grid that ParaView opens as a time series. Rewritten (atomically) after
