@@ -327,6 +327,8 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
   const int nw = rhod_scene_warnings(c.sc, warn, sizeof warn);
   /* set up the particles before touching OUT: a scene that fails here writes nothing */
   st = rhod_sim_init(&c.sim, c.sc, err, sizeof err);
+  char simwarn[4096] = "";
+  const int nsw = st == RHOD_OK ? rhod_sim_warnings(&c.sim, simwarn, sizeof simwarn) : 0;
   if (st == RHOD_OK && resume_out) {
     /* the scene must be the one checkpointed, key for key */
     rhod_param_list now_params;
@@ -403,6 +405,9 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
       line = strtok(NULL, "\n");
     }
   }
+  if (nsw > 0) /* the particles as set up (rhod_sim_warnings) */
+    for (char *line = strtok(simwarn, "\n"); line; line = strtok(NULL, "\n"))
+      logline("rhod: warning: %s", line);
   rhod_scene_params(c.sc, &c.params);
   c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, RHOD_PROBE_COLUMNS_TOTAL);
   c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
