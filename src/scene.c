@@ -1469,13 +1469,17 @@ static int check_limits(lctx *c, rhod_scene *s) {
                 "%g s against time.end = %g s would write %.3g snapshots, more than %.0e",
                 s->output_every, s->t_end, snaps, RHOD_MAX_SNAPSHOTS);
   /* a probe row per sample, at most one per step */
-  const double rows = s->t_end / fmax(s->probe_every, dt_max);
-  if (!(s->probe_every >= 1e-9 * s->t_end) || !(rows <= RHOD_MAX_PROBE_ROWS))
+  if (!(s->probe_every >= 1e-9 * s->t_end))
     return fail(c, "probes.every",
-                "%g s against time.end = %g s would write %.3g rows to probes.csv, more than "
-                "%.0e (and an interval must be at least 1e-9 time.end)",
-                s->probe_every, s->t_end, fmax(rows, s->t_end / s->probe_every),
-                RHOD_MAX_PROBE_ROWS);
+                "%g s is below 1e-9 time.end (%g s), the run's time tolerance: samples that "
+                "close cannot be told apart",
+                s->probe_every, 1e-9 * s->t_end);
+  const double rows = s->t_end / fmax(s->probe_every, dt_max);
+  if (!(rows <= RHOD_MAX_PROBE_ROWS))
+    return fail(c, "probes.every",
+                "%g s against time.end = %g s would write at least %.3g rows to probes.csv (one "
+                "per step at most, each step at most %.3g s), more than %.0e",
+                s->probe_every, s->t_end, rows, dt_max, RHOD_MAX_PROBE_ROWS);
   /* particles: counted before anything is allocated, the lattice is not walked */
   const double n = rhod_scene_particle_estimate(s);
   if (!(n <= RHOD_MAX_PARTICLES))

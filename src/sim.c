@@ -223,7 +223,7 @@ static void block_dropped(const rhod_fill_stats *f, char *buf, size_t len) {
       used += (size_t)snprintf(buf + used, len - used, __VA_ARGS__);                               \
   } while (0)
   if (f->out_container)
-    DROP_PUT("%s%zu lie outside its container walls.%d", used ? ", " : "", f->out_container,
+    DROP_PUT("%s%zu outside its container walls.%d", used ? ", " : "", f->out_container,
              f->container);
   if (f->in_obstacle)
     DROP_PUT("%s%zu inside the obstacle walls.%d", used ? ", " : "", f->in_obstacle, f->obstacle);
@@ -241,7 +241,7 @@ static void block_empty_why(const rhod_sim *s, unsigned b, char *buf, size_t len
   if (dropped) {
     char causes[512];
     block_dropped(f, causes, sizeof causes);
-    snprintf(buf, len, "of its %zu lattice points %s", dropped, causes);
+    snprintf(buf, len, "all %zu of its lattice points are left out: %s", dropped, causes);
   } else {
     snprintf(buf, len,
              "no lattice point of spacing dx falls inside it (it is thinner than dx there) or "
