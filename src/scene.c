@@ -1610,8 +1610,9 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       char sp[160];
       snprintf(sp, sizeof sp, "%s.surface", path);
       if (b->pressure != RHOD_INIT_HYDROSTATIC)
-        return fail(c, sp, "needs pressure: hydrostatic (it is the level of that start's free "
-                           "surface)");
+        return fail(c, sp,
+                    "needs pressure: hydrostatic (it is the level of that start's free "
+                    "surface)");
       if (!(s->gravity[0] != 0 || s->gravity[1] != 0))
         return fail(c, sp, "has no effect without physics.gravity (no hydrostatic pressure)");
       b->surface_set = 1;

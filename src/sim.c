@@ -969,16 +969,17 @@ int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len) {
       near = hypot(p->x[k] - ax, p->y[k] - ay) <= sc->radius_ratio * p->dx[k];
     if (near)
       continue;
-    const int outside = ax < s->lo[0] - R || ax > s->hi[0] + R || ay < s->lo[1] - R ||
-                        ay > s->hi[1] + R;
+    const int outside =
+        ax < s->lo[0] - R || ax > s->hi[0] + R || ay < s->lo[1] - R || ay > s->hi[1] + R;
     const int behind = s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, ax, ay) < -R;
     if (outside || behind)
       sim_warn(&w,
                "%s: probes.list.%u.pressure.at: [%g, %g] lies %s, where no fluid can come: "
                "probe %s will read 0",
                sc->path, i, ax, ay,
-               outside ? "outside the domain" : "behind a wall (inside an obstacle or outside "
-                                                "every container)",
+               outside ? "outside the domain"
+                       : "behind a wall (inside an obstacle or outside "
+                         "every container)",
                pr->name);
   }
 

@@ -20,10 +20,10 @@
  * claimed by an earlier block are in neither. */
 typedef struct {
   size_t kept;
-  size_t out_domain;    /* outside the domain box */
-  size_t in_obstacle;   /* inside an obstacle (walls.N with fluid_inside: false) */
-  size_t out_container; /* outside a container (walls.N with fluid_inside: true) */
-  size_t on_wall;       /* on or just behind a wall otherwise */
+  size_t out_domain;       /* outside the domain box */
+  size_t in_obstacle;      /* inside an obstacle (walls.N with fluid_inside: false) */
+  size_t out_container;    /* outside a container (walls.N with fluid_inside: true) */
+  size_t on_wall;          /* on or just behind a wall otherwise */
   int obstacle, container; /* the first such wall's index, -1 if none */
 } rhod_fill_stats;
 
