@@ -17,7 +17,7 @@ snap >"$T/before"
 n=0
 for scene in "$SRC"/tests/scenes/checks/*.yaml "$RUN"/no_fit_*.yaml; do
   name=$(basename "$scene"); n=$((n + 1))
-  expect 4 "$name" -- "$RHOD" run "$scene" -o "$T/out"
+  expect 4 "$name" -- timeout 30 "$RHOD" run "$scene" -o "$T/out"
   check "$name: one line FILE:LINE:COL: key: reason" -- \
     test "$(wc -l <"$T/stderr")" -eq 1 -a "$(grep -cE "$name:[0-9]+:[0-9]+: [a-z_.0-9]+: " "$T/stderr")" -eq 1
   check "$name: nothing on stdout" -- test ! -s "$T/stdout"
