@@ -328,7 +328,9 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
   /* set up the particles before touching OUT: a scene that fails here writes nothing */
   st = rhod_sim_init(&c.sim, c.sc, err, sizeof err);
   char simwarn[4096] = "";
-  const int nsw = st == RHOD_OK ? rhod_sim_warnings(&c.sim, simwarn, sizeof simwarn) : 0;
+  /* the particles as set up at t = 0 (a resume carries on from a later state: none) */
+  const int nsw =
+      st == RHOD_OK && !resume_out ? rhod_sim_warnings(&c.sim, simwarn, sizeof simwarn) : 0;
   if (st == RHOD_OK && resume_out) {
     /* the scene must be the one checkpointed, key for key */
     rhod_param_list now_params;
