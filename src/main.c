@@ -436,9 +436,11 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   st = rhod_write_xdmf(c->out, c->nsnap, c->snap_t, c->snap_n, err, len);
   if (st != RHOD_OK)
     return st;
+  const rhod_scene *sc = c->sc;
+  if (!sc->picture_enabled) /* output.picture: false */
+    return RHOD_OK;
   char png[4200];
   snprintf(png, sizeof png, "%s/snapshot_%04d.png", c->out, c->nsnap - 1);
-  const rhod_scene *sc = c->sc;
   const double *lo = sc->picture_box_set ? sc->picture_box_min : s->lo;
   const double *hi = sc->picture_box_set ? sc->picture_box_max : s->hi;
   st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_size_panel, sc->picture_width, lo,
@@ -596,6 +598,10 @@ static int run(run_opts *o, const char *resume_out) {
   const int nw = rhod_scene_warnings(c.sc, warn, sizeof warn);
   /* set up the particles before touching OUT: a scene that fails here writes nothing */
   st = rhod_sim_init(&c.sim, c.sc, err, sizeof err);
+  char simwarn[4096] = "";
+  /* the particles as set up at t = 0 (a resume carries on from a later state: none) */
+  const int nsw =
+      st == RHOD_OK && !resume_out ? rhod_sim_warnings(&c.sim, simwarn, sizeof simwarn) : 0;
   if (st == RHOD_OK && resume_out) {
     /* the scene must be the one checkpointed, key for key */
     rhod_param_list now_params;
@@ -729,6 +735,9 @@ static int run(run_opts *o, const char *resume_out) {
       line = strtok(NULL, "\n");
     }
   }
+  if (nsw > 0) /* the particles as set up (rhod_sim_warnings) */
+    for (char *line = strtok(simwarn, "\n"); line; line = strtok(NULL, "\n"))
+      logline("rhod: warning: %s", line);
   if (missing)
     logline("rhod: warning: %d of the %d snapshots the checkpoint lists are missing from %s; "
             "snapshots.xdmf still names them",
@@ -922,6 +931,8 @@ static int check_scene(run_opts *o) {
   rhod_sim sim;
   memset(&sim, 0, sizeof sim);
   st = rhod_sim_init(&sim, sc, err, sizeof err);
+  char simwarn[4096] = "";
+  const int nsw = st == RHOD_OK ? rhod_sim_warnings(&sim, simwarn, sizeof simwarn) : 0;
   if (st == RHOD_OK) {
     rhod_snapshot_view v;
     rhod_sim_fetch(&sim, &v);
@@ -956,6 +967,9 @@ static int check_scene(run_opts *o) {
       line = strtok(NULL, "\n");
     }
   }
+  if (nsw > 0)
+    for (char *line = strtok(simwarn, "\n"); line; line = strtok(NULL, "\n"))
+      printf("warning: %s\n", line);
   rhod_sim_free(&sim);
   rhod_scene_free(sc);
   return RHOD_OK;

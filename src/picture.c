@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MAX_SIDE 16384u
+#define MAX_SIDE RHOD_PICTURE_MAX_SIDE /* the loader checks the same (scene.h) */
 
 typedef struct {
   unsigned char *px; /* RGB, rows top to bottom */

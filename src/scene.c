@@ -61,6 +61,7 @@ typedef struct {
   unsigned n_polygon;
   double *velocity;
   int *pressure;
+  double *surface;
   y_initial *initial;
 } y_fluid;
 
@@ -364,6 +365,7 @@ static const cyaml_schema_field_t f_fluid[] = {
     SHAPE_FIELDS(y_fluid),
     VEC("velocity", OPT, y_fluid, velocity),
     ENUM_OPT("pressure", y_fluid, pressure, init_names),
+    NUM_OPT("surface", y_fluid, surface),
     CYAML_FIELD_MAPPING_PTR("initial", OPT, y_fluid, initial, f_initial),
     CYAML_FIELD_END,
 };
@@ -495,6 +497,7 @@ typedef struct {
   ry_node *root;
   char *err;
   size_t errlen;
+  int picture_off; /* output.picture: false */
 } lctx;
 
 static void put_msg(lctx *c, const char *fmt, ...) {
@@ -1376,6 +1379,117 @@ static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
   return RHOD_OK;
 }
 
+/* Extent of one shape along the unit vector e: [lo, hi] of x.e. */
+static void shape_extent(const rhod_shape *sh, const double e[2], double *lo, double *hi) {
+  *lo = INFINITY;
+  *hi = -INFINITY;
+  switch (sh->kind) {
+  case RHOD_SHAPE_RECT:
+    for (int cx = 0; cx < 2; cx++)
+      for (int cy = 0; cy < 2; cy++) {
+        double x = (cx ? sh->max[0] : sh->min[0]) * e[0] + (cy ? sh->max[1] : sh->min[1]) * e[1];
+        *lo = fmin(*lo, x);
+        *hi = fmax(*hi, x);
+      }
+    break;
+  case RHOD_SHAPE_CIRCLE: {
+    double x = sh->center[0] * e[0] + sh->center[1] * e[1];
+    *lo = x - sh->radius;
+    *hi = x + sh->radius;
+    break;
+  }
+  case RHOD_SHAPE_POLYGON:
+    for (unsigned k = 0; k < sh->n_points; k++) {
+      double x = sh->points[k][0] * e[0] + sh->points[k][1] * e[1];
+      *lo = fmin(*lo, x);
+      *hi = fmax(*hi, x);
+    }
+    break;
+  }
+}
+
+/* Area of the overlap of two boxes. */
+static double box_overlap(const double alo[2], const double ahi[2], const double blo[2],
+                          const double bhi[2]) {
+  double a = 1;
+  for (int d = 0; d < 2; d++)
+    a *= fmax(0, fmin(ahi[d], bhi[d]) - fmax(alo[d], blo[d]));
+  return a;
+}
+
+double rhod_scene_particle_estimate(const rhod_scene *s) {
+  if (!s || !(s->dx > 0))
+    return 0;
+  const double cell = s->dx * s->dx;
+  double n = 0;
+  for (unsigned i = 0; i < s->n_fluid; i++) {
+    n += shape_area(&s->fluid[i].shape) / cell;
+    /* a region at level l puts 4^l particles in each coarse cell it covers */
+    double lo[2], hi[2];
+    shape_bbox(&s->fluid[i].shape, lo, hi);
+    for (unsigned r = 0; r < s->n_regions; r++) {
+      double rlo[2], rhi[2];
+      shape_bbox(&s->regions[r].shape, rlo, rhi);
+      const double area = fmin(box_overlap(lo, hi, rlo, rhi), shape_area(&s->regions[r].shape));
+      n += area / cell * (ldexp(1, 2 * s->regions[r].level) - 1);
+    }
+  }
+  return n;
+}
+
+/* What a run would write or hold, checked before anything is written (docs/choices.md
+ * "load-time limits"): the picture's size, the snapshot and probe-row counts, the steps
+ * time.end needs, the initial particle count. */
+static int check_limits(lctx *c, rhod_scene *s) {
+  /* the picture: src/picture.c draws at most RHOD_PICTURE_MAX_SIDE pixels a side */
+  if (s->picture_enabled) {
+    const double *lo = s->picture_box_set ? s->picture_box_min : s->domain_min;
+    const double *hi = s->picture_box_set ? s->picture_box_max : s->domain_max;
+    const double ex = hi[0] - lo[0], ey = hi[1] - lo[1];
+    const unsigned panels = s->picture_size_panel ? 2 : 1;
+    const double h = floor(s->picture_width * ey / ex + 0.5) * panels;
+    if (!(h <= RHOD_PICTURE_MAX_SIDE))
+      return fail(c, "output.picture.width",
+                  "%u pixels wide makes the picture %.0f pixels high (the %s is %g m x %g m%s), "
+                  "more than %u: lower the width or draw a smaller output.picture.box",
+                  s->picture_width, h, s->picture_box_set ? "box" : "domain", ex, ey,
+                  panels == 2 ? ", two panels" : "", RHOD_PICTURE_MAX_SIDE);
+  }
+  /* time: every step is at most Eq. 11's acoustic bound at the coarsest size */
+  const double dt_max = s->cfl * s->radius_ratio * s->dx / s->c0;
+  const double steps = s->t_end / dt_max;
+  if (!(steps <= RHOD_MAX_STEPS))
+    return fail(c, "time.end",
+                "%g s needs at least %.3g steps (dt <= cfl R/c0 = %.3g s, Eq. 11), more than "
+                "%.0e: in double precision t + dt would keep too few of dt's digits",
+                s->t_end, steps, dt_max, RHOD_MAX_STEPS);
+  const double snaps = s->t_end / s->output_every;
+  if (!(snaps <= RHOD_MAX_SNAPSHOTS))
+    return fail(c, "time.output_every",
+                "%g s against time.end = %g s would write %.3g snapshots, more than %.0e",
+                s->output_every, s->t_end, snaps, RHOD_MAX_SNAPSHOTS);
+  /* a probe row per sample, at most one per step */
+  if (!(s->probe_every >= 1e-9 * s->t_end))
+    return fail(c, "probes.every",
+                "%g s is below 1e-9 time.end (%g s), the run's time tolerance: samples that "
+                "close cannot be told apart",
+                s->probe_every, 1e-9 * s->t_end);
+  const double rows = s->t_end / fmax(s->probe_every, dt_max);
+  if (!(rows <= RHOD_MAX_PROBE_ROWS))
+    return fail(c, "probes.every",
+                "%g s against time.end = %g s would write at least %.3g rows to probes.csv (one "
+                "per step at most, each step at most %.3g s), more than %.0e",
+                s->probe_every, s->t_end, rows, dt_max, RHOD_MAX_PROBE_ROWS);
+  /* particles: counted before anything is allocated, the lattice is not walked */
+  const double n = rhod_scene_particle_estimate(s);
+  if (!(n <= RHOD_MAX_PARTICLES))
+    return fail(c, "particles.dx",
+                "%g m makes about %.3g particles (the fluid's area over dx^2%s), more than the "
+                "%.0e a run can index",
+                s->dx, n, s->n_regions ? " and the refinement regions" : "", RHOD_MAX_PARTICLES);
+  return RHOD_OK;
+}
+
 static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   char path[128];
   /* time */
@@ -1488,6 +1602,22 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     if (y->velocity)
       memcpy(b->velocity, y->velocity, sizeof b->velocity);
     b->pressure = y->pressure ? (rhod_init_kind)*y->pressure : RHOD_INIT_HYDROSTATIC;
+    /* where the block starts, for the messages of the particle set-up (rhod_sim_init) */
+    const ry_node *bn = ry_find_path(c->root, path);
+    if (bn && bn->origin < 0)
+      b->line = bn->line, b->col = bn->col;
+    if (y->surface) {
+      char sp[160];
+      snprintf(sp, sizeof sp, "%s.surface", path);
+      if (b->pressure != RHOD_INIT_HYDROSTATIC)
+        return fail(c, sp,
+                    "needs pressure: hydrostatic (it is the level of that start's free "
+                    "surface)");
+      if (!(s->gravity[0] != 0 || s->gravity[1] != 0))
+        return fail(c, sp, "has no effect without physics.gravity (no hydrostatic pressure)");
+      b->surface_set = 1;
+      b->surface = *y->surface;
+    }
     double lo[2], hi[2];
     shape_bbox(&b->shape, lo, hi);
     if (y->initial) {
@@ -1603,6 +1733,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   }
   /* output */
   const y_picture *pic = d->output ? d->output->picture : NULL;
+  s->picture_enabled = !c->picture_off;
   s->picture_field = pic && pic->field ? (rhod_field)*pic->field : RHOD_FIELD_PRESSURE;
   double width = pic && pic->width ? *pic->width : 800;
   if (!(width >= 64 && width <= 8192 && width == floor(width)))
@@ -1628,6 +1759,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
           s->picture_box_min[1] < s->picture_box_max[1]))
       return fail(c, "output.picture.box.max", "must exceed output.picture.box.min in both axes");
   }
+  TRY(check_limits(c, s));
   /* name */
   if (d->name) {
     if (!valid_name(d->name))
@@ -1829,6 +1961,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
     tb_vec(&t, e, "velocity", s->fluid[i].velocity);
     tb_word(&t, e, "pressure",
             strval_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
+    if (s->fluid[i].surface_set) /* absent at its default, so older checkpoints resume */
+      tb_num(&t, e, "surface", s->fluid[i].surface);
     const rhod_fluid_block *fb = &s->fluid[i];
     if (fb->flow != RHOD_FLOW_NONE) {
       ry_node *in = tb_coll(&t, e, "initial", RY_MAP, 0);
@@ -1895,6 +2029,10 @@ static ry_node *scene_tree(const rhod_scene *s) {
     tb_num(&t, e, "from", s->field_from);
   }
   m = tb_coll(&t, root, "output", RY_MAP, 0);
+  if (!s->picture_enabled) {
+    tb_bool(&t, m, "picture", 0);
+    goto done;
+  }
   m = tb_coll(&t, m, "picture", RY_MAP, 0);
   tb_word(&t, m, "field",
           strval_name(field_names, CYAML_ARRAY_LEN(field_names), (int)s->picture_field));
@@ -1907,6 +2045,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
     tb_vec(&t, b, "min", s->picture_box_min);
     tb_vec(&t, b, "max", s->picture_box_max);
   }
+done:
   if (t.oom) {
     ry_free(root);
     return NULL;
@@ -1937,11 +2076,33 @@ void rhod_scene_free(rhod_scene *s) {
   free(s);
 }
 
+/* output.picture is a mapping or a switch: true (the defaults) or false (no pictures).
+ * A switch becomes an empty mapping for libcyaml, remembered in c->picture_off. */
+static int picture_switch(lctx *c) {
+  ry_node *o = c->root->kind == RY_MAP ? ry_map_get(c->root, "output") : NULL;
+  ry_node *pic = o && o->kind == RY_MAP ? ry_map_get(o, "picture") : NULL;
+  if (!pic || pic->kind != RY_SCALAR)
+    return RHOD_OK;
+  bool on;
+  if (!parse_bool(pic->text, &on))
+    return fail_at(c, pic, "output.picture", "expected a mapping, true or false, got '%s'",
+                   pic->text);
+  ry_node *empty = ry_new(RY_MAP, pic->origin, pic->line, pic->col);
+  if (!empty)
+    return fail_oom(c);
+  empty->flow = 1;
+  ry_replace(pic, empty);
+  c->picture_off = !on;
+  return RHOD_OK;
+}
+
 static int load_document(lctx *c, rhod_scene **out) {
   int rc;
   for (int k = 0; k < c->n_ov; k++)
     if ((rc = apply_override(c, k)))
       return rc;
+  if ((rc = picture_switch(c)))
+    return rc;
   annotate(c->root, &sch_doc);
 
   /* the text libcyaml reads, and where each node sits in it */
@@ -2194,30 +2355,10 @@ static void fluid_extent(const rhod_scene *s, const double e[2], double *lo, dou
   *lo = INFINITY;
   *hi = -INFINITY;
   for (unsigned i = 0; i < s->n_fluid; i++) {
-    const rhod_shape *sh = &s->fluid[i].shape;
-    switch (sh->kind) {
-    case RHOD_SHAPE_RECT:
-      for (int cx = 0; cx < 2; cx++)
-        for (int cy = 0; cy < 2; cy++) {
-          double x = (cx ? sh->max[0] : sh->min[0]) * e[0] + (cy ? sh->max[1] : sh->min[1]) * e[1];
-          *lo = fmin(*lo, x);
-          *hi = fmax(*hi, x);
-        }
-      break;
-    case RHOD_SHAPE_CIRCLE: {
-      double x = sh->center[0] * e[0] + sh->center[1] * e[1];
-      *lo = fmin(*lo, x - sh->radius);
-      *hi = fmax(*hi, x + sh->radius);
-      break;
-    }
-    case RHOD_SHAPE_POLYGON:
-      for (unsigned k = 0; k < sh->n_points; k++) {
-        double x = sh->points[k][0] * e[0] + sh->points[k][1] * e[1];
-        *lo = fmin(*lo, x);
-        *hi = fmax(*hi, x);
-      }
-      break;
-    }
+    double a, b;
+    shape_extent(&s->fluid[i].shape, e, &a, &b);
+    *lo = fmin(*lo, a);
+    *hi = fmax(*hi, b);
   }
 }
 
@@ -2261,8 +2402,24 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
 
   if (s->output_every > s->t_end)
     warn(&w,
-         "%s: time.output_every: %g s exceeds time.end = %g s: only the initial state is written",
+         "%s: time.output_every: %g s exceeds time.end = %g s: two snapshots are written, at "
+         "t = 0 and at the end",
          file, s->output_every, s->t_end);
+
+  /* a free-surface level below the block's top: the particles above it start in tension */
+  for (unsigned i = 0; i < s->n_fluid && g > 0; i++) {
+    const rhod_fluid_block *b = &s->fluid[i];
+    if (!b->surface_set)
+      continue;
+    const double up[2] = {-s->gravity[0] / g, -s->gravity[1] / g};
+    double lo, hi;
+    shape_extent(&b->shape, up, &lo, &hi);
+    if (b->surface < hi - 1e-9 * fmax(1, fabs(hi)))
+      warn(&w,
+           "%s: fluid.%u.surface: %g m is below the block's top (%g m along -g): the particles "
+           "above it start with a negative (tensile) pressure",
+           file, i, b->surface, hi);
+  }
 
   if (s->picture_range_set && s->picture_field == RHOD_FIELD_FREE_SURFACE)
     warn(&w, "%s: output.picture.range: ignored for field free_surface (a flag, not a scale)",

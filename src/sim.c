@@ -1,11 +1,14 @@
 /* Simulation set-up, stepping, checks and probes. */
+#define _DEFAULT_SOURCE /* sysconf(_SC_PHYS_PAGES) */
 #include "rhod/sim.h"
 #include "kernel.h"
 #include <float.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -131,8 +134,10 @@ static void set_state(rhod_sim *s, unsigned b, size_t k, double x, double y, dou
   const double c2 = sc->c0 * sc->c0;
   double P = 0;
   if (B->pressure == RHOD_INIT_HYDROSTATIC) {
-    /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1) */
-    const double depth = shape_top(&B->shape, ex, ey) - (x * ex + y * ey);
+    /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1), the free surface
+     * at fluid.N.surface (default the block's top along -g) */
+    const double top = B->surface_set ? B->surface : shape_top(&B->shape, ex, ey);
+    const double depth = top - (x * ex + y * ey);
     P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
   }
   double u = B->velocity[0], v = B->velocity[1];
@@ -160,14 +165,88 @@ static void set_state(rhod_sim *s, unsigned b, size_t k, double x, double y, dou
   p->id[k] = k;
 }
 
-/* One fluid particle of size dx at (x, y) of block b, if the point belongs to block b
- * (fluid_block_at). Counts it; writes it when `write`. */
-static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t *n, int write) {
-  if (fluid_block_at(s, x, y) != (int)b)
+/* Why a lattice point of block b that fluid_block_at refused is left out (s->fill). */
+static void count_dropped(rhod_sim *s, unsigned b, double x, double y) {
+  const rhod_scene *sc = s->sc;
+  rhod_fill_stats *f = &s->fill[b];
+  if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1]) {
+    f->out_domain++;
     return;
+  }
+  for (unsigned w = 0; w < sc->n_walls; w++)
+    if (!sc->walls[w].fluid_inside && in_shape(&sc->walls[w].shape, x, y)) {
+      f->in_obstacle++;
+      f->obstacle = f->obstacle < 0 ? (int)w : f->obstacle;
+      return;
+    }
+  for (unsigned w = 0; w < sc->n_walls; w++)
+    if (sc->walls[w].fluid_inside && !in_shape(&sc->walls[w].shape, x, y)) {
+      f->out_container++;
+      f->container = f->container < 0 ? (int)w : f->container;
+      return;
+    }
+  f->on_wall++;
+}
+
+/* One fluid particle of size dx at (x, y) of block b, if the point belongs to block b
+ * (fluid_block_at). Counts it; writes it when `write`, else keeps the fill's tally. */
+static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t *n, int write) {
+  const int owner = fluid_block_at(s, x, y);
+  if (owner != (int)b) {
+    if (!write && owner < 0 && in_shape(&s->sc->fluid[b].shape, x, y))
+      count_dropped(s, b, x, y);
+    return;
+  }
   if (write)
     set_state(s, b, *n, x, y, dx);
+  else
+    s->fill[b].kept++;
   (*n)++;
+}
+
+/* "FILE:LINE:COL: fluid.N" (or the override's note) for a message about block b. */
+static void block_where(const rhod_scene *sc, unsigned b, char *buf, size_t len) {
+  const rhod_fluid_block *B = &sc->fluid[b];
+  if (B->line)
+    snprintf(buf, len, "%s:%u:%u: fluid.%u", sc->path, B->line, B->col, b);
+  else
+    snprintf(buf, len, "%s: fluid.%u (given by --set)", sc->path, b);
+}
+
+/* The causes of a block's left-out points: "N lie outside its container walls.K, M ...". */
+static void block_dropped(const rhod_fill_stats *f, char *buf, size_t len) {
+  size_t used = 0;
+  buf[0] = '\0';
+#define DROP_PUT(...)                                                                              \
+  do {                                                                                             \
+    if (used < len)                                                                                \
+      used += (size_t)snprintf(buf + used, len - used, __VA_ARGS__);                               \
+  } while (0)
+  if (f->out_container)
+    DROP_PUT("%s%zu outside its container walls.%d", used ? ", " : "", f->out_container,
+             f->container);
+  if (f->in_obstacle)
+    DROP_PUT("%s%zu inside the obstacle walls.%d", used ? ", " : "", f->in_obstacle, f->obstacle);
+  if (f->out_domain)
+    DROP_PUT("%s%zu outside the domain", used ? ", " : "", f->out_domain);
+  if (f->on_wall)
+    DROP_PUT("%s%zu on a wall", used ? ", " : "", f->on_wall);
+#undef DROP_PUT
+}
+
+/* Why block b holds no particle, for the "no particle fits" error. */
+static void block_empty_why(const rhod_sim *s, unsigned b, char *buf, size_t len) {
+  const rhod_fill_stats *f = &s->fill[b];
+  const size_t dropped = f->out_container + f->in_obstacle + f->out_domain + f->on_wall;
+  if (dropped) {
+    char causes[512];
+    block_dropped(f, causes, sizeof causes);
+    snprintf(buf, len, "all %zu of its lattice points are left out: %s", dropped, causes);
+  } else {
+    snprintf(buf, len,
+             "no lattice point of spacing dx falls inside it (it is thinner than dx there) or "
+             "an earlier block holds them");
+  }
 }
 
 /* The lattice cell of size f dx0 (f = 2^-l at level l) centred at lo + (ci, cj) dx0:
@@ -216,8 +295,11 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
     }
     if (pass == 0) {
       if (n == 0) {
-        snprintf(err, errlen, "%s: fluid: no particle fits in the fluid blocks at dx = %g",
-                 sc->path, dx);
+        char where[512], why[768];
+        block_where(sc, 0, where, sizeof where);
+        block_empty_why(s, 0, why, sizeof why);
+        snprintf(err, errlen, "%s: no particle fits at dx = %g m: %s%s", where, dx, why,
+                 sc->n_fluid > 1 ? "; no other block holds one either" : "");
         return RHOD_ERR_SCENE;
       }
       if (n > 2000000000u) {
@@ -308,6 +390,30 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
              RHOD_MAX_LEVELS);
     return RHOD_ERR_SCENE;
   }
+  /* the lattice is not walked for a count the machine cannot hold (docs/choices.md
+   * "load-time limits"): the loader refuses more than RHOD_MAX_PARTICLES, this the memory */
+  const double est = rhod_scene_particle_estimate(sc);
+  const double mem = (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+  if (!(est <= RHOD_MAX_PARTICLES)) {
+    snprintf(err, errlen, "%s: particles.dx: %g m makes about %.3g particles, more than %.0e",
+             sc->path, sc->dx, est, RHOD_MAX_PARTICLES);
+    return RHOD_ERR_SCENE;
+  }
+  if (mem > 0 && est * (double)RHOD_BYTES_PER_PARTICLE > mem) {
+    snprintf(err, errlen,
+             "%s: particles.dx: %g m makes about %.3g particles, at least %.3g GB at %zu bytes "
+             "each, more than this machine's %.3g GB of memory",
+             sc->path, sc->dx, est, est * (double)RHOD_BYTES_PER_PARTICLE / 1e9,
+             (size_t)RHOD_BYTES_PER_PARTICLE, mem / 1e9);
+    return RHOD_ERR_MEMORY;
+  }
+  s->fill = calloc(sc->n_fluid ? sc->n_fluid : 1, sizeof *s->fill);
+  if (!s->fill) {
+    snprintf(err, errlen, "out of memory setting up the particles");
+    return RHOD_ERR_MEMORY;
+  }
+  for (unsigned b = 0; b < sc->n_fluid; b++)
+    s->fill[b].obstacle = s->fill[b].container = -1;
   if (sc->has_domain) {
     for (int a = 0; a < 2; a++)
       s->lo[a] = sc->domain_min[a], s->hi[a] = sc->domain_max[a];
@@ -433,6 +539,8 @@ static int refine_initial(rhod_sim *s, char *err, size_t errlen) {
 }
 
 void rhod_sim_free(rhod_sim *s) {
+  free(s->fill);
+  s->fill = NULL;
   rhod_apr_free(&s->apr);
   rhod_cells_free(&s->cells);
   rhod_boundary_free(&s->bnd);
@@ -773,4 +881,123 @@ void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
                             .size = p->dx,
                             .id = p->id,
                             .fs = s->sph.fs};
+}
+
+/* ---- warnings about the particles as set up -------------------------------------------- */
+
+typedef struct {
+  char *buf;
+  size_t len, used;
+  int count;
+} sim_warn_buf;
+
+static void sim_warn(sim_warn_buf *w, const char *fmt, ...) {
+  if (w->buf && w->len && w->used + 1 < w->len) {
+    if (w->count)
+      w->used += (size_t)snprintf(w->buf + w->used, w->len - w->used, "\n");
+    if (w->used + 1 < w->len) {
+      va_list ap;
+      va_start(ap, fmt);
+      int n = vsnprintf(w->buf + w->used, w->len - w->used, fmt, ap);
+      va_end(ap);
+      if (n > 0)
+        w->used += (size_t)n;
+      if (w->used >= w->len)
+        w->used = w->len - 1;
+    }
+  }
+  w->count++;
+}
+
+/* Whether the ray from (x, y) along the unit vector d meets a wall. */
+static int wall_along(const rhod_boundary *b, double x, double y, const double d[2]) {
+  for (int k = 0; k < b->nseg; k++) {
+    const real *S = b->seg + RHOD_SEG_STRIDE * k;
+    const double tx = S[4], ty = S[5], ax = S[0] - x, ay = S[1] - y;
+    const double den = d[0] * ty - d[1] * tx;
+    if (fabs(den) < 1e-12)
+      continue;
+    const double t = (ax * ty - ay * tx) / den, u = (ax * d[1] - ay * d[0]) / den;
+    if (t > 0 && u >= 0 && u <= S[6])
+      return 1;
+  }
+  for (int k = 0; k < b->ncirc; k++) {
+    const real *C = b->circ + RHOD_CIRC_STRIDE * k;
+    const double px = x - C[0], py = y - C[1];
+    const double hb = px * d[0] + py * d[1], c = px * px + py * py - (double)C[2] * C[2];
+    const double disc = hb * hb - c;
+    if (disc >= 0 && -hb + sqrt(disc) > 0)
+      return 1;
+  }
+  return 0;
+}
+
+int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len) {
+  sim_warn_buf w = {buf, len, 0, 0};
+  if (buf && len)
+    buf[0] = '\0';
+  if (!s || !s->sc)
+    return 0;
+  const rhod_scene *sc = s->sc;
+  rhod_particles *p = &s->p;
+  rhod_particles_to_host(p);
+  const size_t n = p->n;
+
+  /* fluid left out of its block by walls or the domain */
+  for (unsigned b = 0; s->fill && b < sc->n_fluid; b++) {
+    const rhod_fill_stats *f = &s->fill[b];
+    const size_t dropped = f->out_container + f->in_obstacle + f->out_domain + f->on_wall;
+    if (!dropped)
+      continue;
+    char where[512], causes[512];
+    block_where(sc, b, where, sizeof where);
+    block_dropped(f, causes, sizeof causes);
+    sim_warn(&w, "%s: %zu of the %zu particles of its lattice are left out: %s", where, dropped,
+             dropped + f->kept, causes);
+  }
+
+  /* pressure probes no fluid can reach: nothing within R at t = 0, and more than R
+   * behind a wall (inside an obstacle or outside every container) or outside the domain */
+  const double R = sc->radius_ratio * sc->dx;
+  for (unsigned i = 0; i < sc->n_probes; i++) {
+    const rhod_probe *pr = &sc->probes[i];
+    if (pr->kind != RHOD_PROBE_PRESSURE)
+      continue;
+    const double ax = pr->at[0], ay = pr->at[1];
+    int near = 0;
+    for (size_t k = 0; k < n && !near; k++)
+      near = hypot(p->x[k] - ax, p->y[k] - ay) <= sc->radius_ratio * p->dx[k];
+    if (near)
+      continue;
+    const int outside =
+        ax < s->lo[0] - R || ax > s->hi[0] + R || ay < s->lo[1] - R || ay > s->hi[1] + R;
+    const int behind = s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, ax, ay) < -R;
+    if (outside || behind)
+      sim_warn(&w,
+               "%s: probes.list.%u.pressure.at: [%g, %g] lies %s, where no fluid can come: "
+               "probe %s will read 0",
+               sc->path, i, ax, ay,
+               outside ? "outside the domain"
+                       : "behind a wall (inside an obstacle or outside "
+                         "every container)",
+               pr->name);
+  }
+
+  /* gravity with nothing below: the fall along the non-periodic axes (a periodic axis
+   * wraps) from each particle meets no wall */
+  double d[2] = {sc->periodic[0] ? 0 : sc->gravity[0], sc->periodic[1] ? 0 : sc->gravity[1]};
+  const double g = hypot(d[0], d[1]);
+  if (g > 0) {
+    d[0] /= g, d[1] /= g;
+    size_t falling = 0;
+    for (size_t k = 0; k < n; k++)
+      falling += !wall_along(&s->bnd, p->x[k], p->y[k], d);
+    if (falling)
+      sim_warn(&w,
+               "%s: physics.gravity: %zu of the %zu fluid particles have no wall below them "
+               "(along gravity, outside the periodic axes): they will leave the domain, and the "
+               "run then stops as unstable",
+               sc->path, falling, n);
+  }
+  return w.count;
 }

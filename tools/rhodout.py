@@ -1,7 +1,11 @@
 """Reading rhod output folders: snapshots (HDF5), probes.csv, scene parameters.
 
 Used by the cases' check and study scripts. Needs Debian's python3-numpy and
-python3-h5py (installed by scripts/setup.sh)."""
+python3-h5py (installed by scripts/setup.sh), and python3-matplotlib for the plots.
+
+As a command, `python3 tools/rhodout.py OUT` prints the run's summary (summary.json)
+and plots probes.csv into OUT/probes.png, one panel per probe."""
+import argparse
 import csv
 import datetime
 import glob
@@ -9,6 +13,7 @@ import json
 import os
 import platform
 import subprocess
+import sys
 
 import h5py
 import numpy as np
@@ -124,3 +129,104 @@ def mirror_walls(pos, walls, reach):
         m[axis, axis] = -1
         allpos.append(mp), src.append(near), maps.append(np.tile(m, (len(near), 1, 1)))
     return np.concatenate(allpos), np.concatenate(src), np.concatenate(maps)
+
+
+# Column suffixes of the probes with several columns (rhod_probe_suffix in src/scene.c):
+# a momentum probe's NAME_x, NAME_y, a torque budget's seven terms.
+GROUP_SUFFIXES = ("_x", "_y", "_pressure", "_viscous", "_riemann", "_damper", "_shifting",
+                  "_body", "_motion")
+
+
+def probe_groups(columns):
+    """The probe columns (t left out) grouped into panels: a probe's columns together."""
+    groups, order = {}, []
+    for c in columns:
+        if c == "t":
+            continue
+        key = c
+        for suf in GROUP_SUFFIXES:
+            stem = c[: -len(suf)]
+            if c.endswith(suf) and stem and sum(o.startswith(stem + "_") and
+                                                 o[len(stem):] in GROUP_SUFFIXES
+                                                 for o in columns) >= 2:
+                key = stem
+                break
+        if key not in groups:
+            groups[key] = []
+            order.append(key)
+        groups[key].append(c)
+    return [(k, groups[k]) for k in order]
+
+
+def plot_probes(out, path=None):
+    """probes.csv of a run as a PNG (matplotlib, Agg): one panel per probe against t.
+    Returns the path written, or None when the run has no probe column or no row."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with open(os.path.join(out, "probes.csv")) as f:
+        rows = [r for r in csv.reader(f) if r]
+    if len(rows) < 2 or len(rows[0]) < 2:
+        return None
+    head = rows[0]
+    data = np.array([[float(v) for v in r] for r in rows[1:]], dtype=float)
+    col = {h: data[:, k] for k, h in enumerate(head)}
+    groups = probe_groups(head)
+    fig, axes = plt.subplots(len(groups), 1, figsize=(7, 2.2 * len(groups) + 0.6),
+                             sharex=True, squeeze=False)
+    for ax, (name, cols) in zip(axes[:, 0], groups):
+        for c in cols:
+            ax.plot(col["t"], col[c], label=c, lw=1.2, marker="." if len(data) < 30 else None)
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+        if len(cols) > 1:
+            ax.legend(fontsize=7, loc="best")
+    axes[-1, 0].set_xlabel("t [s]")
+    fig.suptitle(os.path.basename(os.path.normpath(out)) + ": probes.csv")
+    fig.tight_layout()
+    path = path or os.path.join(out, "probes.png")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(
+        prog="rhodout.py",
+        description="Prints a rhod run's summary and plots its probes into OUT/probes.png.")
+    ap.add_argument("out", metavar="OUT", help="the run's output folder")
+    args = ap.parse_args(argv)
+    out = args.out
+    if not os.path.isdir(out):
+        print(f"rhodout.py: {out}: not a folder", file=sys.stderr)
+        return 2
+    try:
+        s = summary(out)
+    except (OSError, ValueError) as e:
+        print(f"rhodout.py: {out}/summary.json: {e}", file=sys.stderr)
+        return 1
+    status = s.get("status", "?")
+    cause = s.get("cause", "")
+    print(f"{out}: {status}" + (f" ({cause})" if cause else ""))
+    print(f"  time {s.get('time', 0):.6g} s, {s.get('steps', 0)} steps, "
+          f"{s.get('particles', 0)} particles")
+    print(f"  wall time {s.get('wall_seconds', 0):.4g} s, "
+          f"{s.get('us_per_particle_step', 0):.4g} us per particle-step, "
+          f"{s.get('precision', '?')} precision, kernels on {s.get('kernels_ran_on', '?')}")
+    for k, v in (s.get("probes") or {}).items():
+        print(f"  {k} = {v:.9g}")
+    if not os.path.exists(os.path.join(out, "probes.csv")):
+        print("  no probes.csv")
+        return 0
+    try:
+        path = plot_probes(out)
+    except (OSError, ValueError) as e:
+        print(f"rhodout.py: {out}/probes.csv: {e}", file=sys.stderr)
+        return 1
+    print(f"  probes plotted: {path}" if path else "  no probe samples to plot")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -49,7 +49,13 @@ typedef struct {
   double flow_center[2];   /* rotation: centre [m], default the block's centre */
   double velocity[2];      /* initial velocity [m/s], default 0 */
   rhod_init_kind pressure; /* uniform (P = 0) or hydrostatic (paper 002 Sec. VI A,
-                              free surface at the block's highest point along -g) */
+                              free surface at `surface`) */
+  int surface_set;         /* fluid.N.surface given */
+  double surface;          /* hydrostatic: the free surface's level along -g [m], i.e. x.e
+                              with e = -g/|g| (for g along -y, its y); default the block's
+                              highest point along -g */
+  unsigned line, col;      /* where the block starts in the scene file (for messages);
+                              0, 0 when an override (--set) supplied it */
 } rhod_fluid_block;
 
 typedef enum { RHOD_SLIP_FREE = 0, RHOD_SLIP_NO } rhod_slip;
@@ -244,6 +250,7 @@ typedef struct {
   double field_above, field_below; /* thresholds (+-HUGE_VAL when absent) */
   double field_from;               /* refinement.field.from [s], default 0 */
   /* output: */
+  int picture_enabled;      /* output.picture: false switches pictures off; default 1 */
   rhod_field picture_field; /* output.picture.field, default pressure */
   unsigned picture_width;   /* output.picture.width [pixels], default 800 */
   int picture_size_panel;   /* output.picture.size_panel: a second panel coloured by size,
@@ -278,5 +285,19 @@ void rhod_param_list_free(rhod_param_list *p);
 /* Physical plausibility warnings that do not stop a run (e.g. c0 below the Eq. 2 bound),
  * one line each, written to buf separated by '\n'. Returns how many. */
 int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len);
+
+/* Limits the loader enforces on what a run would write or hold (docs/choices.md "load-time
+ * limits"): the picture's sides, the snapshots and probe rows a run writes, the steps
+ * that t_end needs at the largest dt Eq. 11 allows, and the initial particle count. */
+#define RHOD_PICTURE_MAX_SIDE 16384u /* pixels, each side (src/picture.c) */
+#define RHOD_MAX_SNAPSHOTS 1e6
+#define RHOD_MAX_PROBE_ROWS 1e8
+#define RHOD_MAX_STEPS 1e12
+#define RHOD_MAX_PARTICLES 2e9 /* int32 particle indices (cells, permutations) */
+
+/* The initial fluid particle count a scene asks for, estimated from the blocks' areas
+ * over dx^2 and, with refinement regions, the finer lattices of their overlap with the
+ * blocks' bounding boxes (an upper estimate there). Before walls and domain cut it. */
+double rhod_scene_particle_estimate(const rhod_scene *s);
 
 #endif

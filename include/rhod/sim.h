@@ -15,8 +15,21 @@
 /* Steps between two searches for coalescing groups (refinement.coalesce). */
 #define RHOD_COALESCE_EVERY 10
 
+/* What the initial fill did with one fluid block's lattice points: those inside its shape
+ * that became particles, and those left out, by cause (the first wall named). Points
+ * claimed by an earlier block are in neither. */
+typedef struct {
+  size_t kept;
+  size_t out_domain;       /* outside the domain box */
+  size_t in_obstacle;      /* inside an obstacle (walls.N with fluid_inside: false) */
+  size_t out_container;    /* outside a container (walls.N with fluid_inside: true) */
+  size_t on_wall;          /* on or just behind a wall otherwise */
+  int obstacle, container; /* the first such wall's index, -1 if none */
+} rhod_fill_stats;
+
 typedef struct {
   const rhod_scene *sc;
+  rhod_fill_stats *fill; /* per fluid block, from rhod_sim_init */
   rhod_particles p;
   rhod_boundary bnd;
   rhod_cells cells;
@@ -40,6 +53,16 @@ typedef struct {
  * sets everything up on the device. */
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen);
 void rhod_sim_free(rhod_sim *s);
+
+/* Warnings about the particles as set up (after rhod_sim_init), one line each into buf,
+ * separated by '\n': fluid left out of a block by walls or the domain, pressure probes
+ * the fluid can never reach, fluid with nothing below it along gravity. Returns how many. */
+int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len);
+
+/* Bytes per fluid particle the memory check of rhod_sim_init assumes: a lower bound of
+ * what a run holds (the store with its spare room, ghosts, cells; measured about 900 in
+ * double precision on the dam break), so that a refused scene would not have fitted. */
+#define RHOD_BYTES_PER_PARTICLE (64 * sizeof(real))
 
 /* Makes ghosts and cells match the current state (sorting the fluid by cell first when
  * sort != 0). After it, probes and outputs see consistent ghost values. */
