@@ -4,6 +4,7 @@
 #include "rhod/io.h"
 #include "rhod/scene.h"
 #include "rhod/sim.h"
+#include "rhod/version.h"
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
@@ -180,7 +181,7 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   c->snap_t[c->nsnap] = s->t;
   c->snap_n[c->nsnap] = s->p.n;
   c->nsnap++;
-  st = rhod_write_xdmf(c->out, c->nsnap, c->snap_t, c->snap_n, err, len);
+  st = rhod_write_xdmf(c->out, c->nsnap, c->snap_t, c->snap_n, rhod_snapshot_fields(&v), err, len);
   if (st != RHOD_OK)
     return st;
   char png[4200];
@@ -189,7 +190,8 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   const double *lo = sc->picture_box_set ? sc->picture_box_min : s->lo;
   const double *hi = sc->picture_box_set ? sc->picture_box_max : s->hi;
   st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_size_panel, sc->picture_width, lo,
-                          hi, sc->picture_range_set ? sc->picture_range : NULL, err, len);
+                          hi, sc->picture_range_set ? sc->picture_range : NULL, sc->walls,
+                          sc->n_walls, err, len);
   return st;
 }
 
@@ -363,6 +365,8 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
   }
   if (st == RHOD_OK)
     st = check_output_dir(out, err, sizeof err);
+  if (st == RHOD_OK)
+    st = rhod_write_walls(out, c.sc, err, sizeof err);
   if (st != RHOD_OK) {
     fprintf(stderr, "rhod: %s\n", err);
     rhod_sim_free(&c.sim);
@@ -585,7 +589,7 @@ int main(int argc, char **argv) {
     return argc < 2 ? RHOD_ERR_USAGE : 0;
   }
   if (!strcmp(argv[1], "--version")) {
-    printf("rhod 0.1 (%s precision, %s)\n", RHOD_REAL_NAME,
+    printf("rhod %s (commit %s, %s precision, %s)\n", rhod_version(), rhod_commit(), RHOD_REAL_NAME,
 #ifdef RHOD_OFFLOAD
            "nvptx offload"
 #else
