@@ -11,6 +11,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <hdf5.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -279,11 +280,37 @@ static int write_header(h5_reason *R, hid_t file, const rhod_snapshot_view *v) {
   return close_group(R, g, rc);
 }
 
-static int write_params(h5_reason *R, hid_t file, const rhod_param_list *params) {
-  /* Creation order is tracked so that a reader gets the keys back in scene order. The
-   * attributes are kept in dense storage (a heap and B-trees beside the group, from the
-   * first one): compact storage lives in the group's object header, which overflows at
-   * 64 KiB, a few thousand keys (a scene with very many blocks). */
+/* HDF5 numbers an object's attributes in creation order with 16 bits: past this many, a
+ * group cannot track their order ("attribute creation index can't be incremented"). */
+#define MAX_TRACKED_ATTRS 65535u
+
+/* A 1D dataset of variable-length strings (NULL written as ""). */
+static int write_strings(h5_reason *R, hid_t loc, const char *name, char *const *s, unsigned n) {
+  const char **v = malloc((n ? n : 1) * sizeof *v);
+  if (!v)
+    return -2;
+  for (unsigned i = 0; i < n; i++)
+    v[i] = s[i] ? s[i] : "";
+  hid_t t = H5Tcopy(H5T_C_S1);
+  int rc = -1;
+  if (t >= 0 && H5Tset_size(t, H5T_VARIABLE) >= 0)
+    rc = write_dataset(R, loc, name, t, t, n, 0, v, "");
+  else
+    note(R);
+  if (t >= 0)
+    H5Tclose(t);
+  free(v);
+  return rc;
+}
+
+/* /Parameters: the scene as run, as two datasets Keys and Values (variable-length strings,
+ * in scene order: any number of keys) and, for h5py's f["Parameters"].attrs and older
+ * readers, one string attribute per key, in creation order, while there are at most
+ * 65535 keys (HDF5's limit for a tracked order; without it, HDF5 1.10 takes minutes to
+ * add that many). The attributes are kept in dense storage (a heap and B-trees beside
+ * the group): compact storage in the group's object header overflows at 64 KiB. */
+static int write_params(h5_reason *R, hid_t file, const rhod_param_list *params, int *oom) {
+  const unsigned n = params ? params->n : 0;
   hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
   if (gcpl < 0) {
     note(R);
@@ -300,8 +327,14 @@ static int write_params(h5_reason *R, hid_t file, const rhod_param_list *params)
   if (g < 0)
     return -1;
   int rc = 0;
-  for (unsigned i = 0; params && i < params->n && !rc; i++)
+  for (unsigned i = 0; n <= MAX_TRACKED_ATTRS && i < n && !rc; i++)
     rc = write_str_attr(R, g, params->keys[i], params->values[i] ? params->values[i] : "");
+  if (!rc)
+    rc = write_strings(R, g, "Keys", n ? params->keys : NULL, n);
+  if (!rc)
+    rc = write_strings(R, g, "Values", n ? params->values : NULL, n);
+  if (rc == -2)
+    *oom = 1;
   return close_group(R, g, rc);
 }
 
@@ -376,7 +409,7 @@ static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_vie
     bad = write_mesh(R, file, n, buf) != 0;
   free(buf);
   if (!bad)
-    bad = write_params(R, file, params) != 0;
+    bad = write_params(R, file, params, oom) != 0;
   if (file < 0)
     return NULL;
   return close_image(R, file, bad, size, oom);
@@ -763,6 +796,70 @@ static herr_t param_cb(hid_t loc, const char *name, const H5A_info_t *info, void
   return 0;
 }
 
+/* A 1D dataset of strings (variable or fixed length) into malloc'd strings; *n its
+ * length. Returns RHOD_OK, RHOD_ERR_READ or RHOD_ERR_MEMORY. */
+static int read_strings(reader *r, hid_t g, const char *name, char ***out, size_t *n) {
+  char what[64];
+  snprintf(what, sizeof what, "/Parameters/%s", name);
+  *out = NULL;
+  *n = 0;
+  hid_t d = H5Dopen2(g, name, H5P_DEFAULT);
+  if (d < 0)
+    return rfail(r, what);
+  hid_t sp = H5Dget_space(d), ft = H5Dget_type(d);
+  hsize_t dims[1] = {0};
+  int rc = RHOD_OK;
+  if (sp < 0 || ft < 0 || H5Sget_simple_extent_ndims(sp) != 1 || H5Tget_class(ft) != H5T_STRING ||
+      H5Tis_variable_str(ft) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen, "%s: %s is not a list of variable-length strings", r->path, what);
+    rc = RHOD_ERR_READ;
+  }
+  if (!rc)
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+  size_t len = (size_t)dims[0];
+  char **raw = rc ? NULL : calloc(len ? len : 1, sizeof *raw);
+  char **copy = rc ? NULL : calloc(len ? len : 1, sizeof *copy);
+  hid_t mt = -1;
+  if (!rc && (!raw || !copy))
+    rc = RHOD_ERR_MEMORY;
+  if (!rc) {
+    mt = H5Tcopy(H5T_C_S1);
+    if (mt < 0 || H5Tset_size(mt, H5T_VARIABLE) < 0 ||
+        (len && H5Dread(d, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw) < 0))
+      rc = rfail(r, what);
+  }
+  for (size_t i = 0; !rc && i < len; i++)
+    if (!(copy[i] = strdup(raw[i] ? raw[i] : "")))
+      rc = RHOD_ERR_MEMORY;
+  if (mt >= 0 && raw && len) {
+#if H5_VERSION_GE(1, 12, 0)
+    H5Treclaim(mt, sp, H5P_DEFAULT, raw);
+#else
+    H5Dvlen_reclaim(mt, sp, H5P_DEFAULT, raw);
+#endif
+  }
+  if (mt >= 0)
+    H5Tclose(mt);
+  free(raw);
+  if (rc == RHOD_ERR_MEMORY)
+    set_err(r->err, r->errlen, "%s: out of memory reading %s", r->path, what);
+  if (rc) {
+    for (size_t i = 0; copy && i < len; i++)
+      free(copy[i]);
+    free(copy);
+  } else {
+    *out = copy;
+    *n = len;
+  }
+  if (ft >= 0)
+    H5Tclose(ft);
+  if (sp >= 0)
+    H5Sclose(sp);
+  H5Dclose(d);
+  return rc;
+}
+
 static int read_params(reader *r, rhod_param_list *out) {
   if (H5Lexists(r->file, "/Parameters", H5P_DEFAULT) <= 0) {
     H5Eclear2(H5E_DEFAULT);
@@ -771,6 +868,34 @@ static int read_params(reader *r, rhod_param_list *out) {
   hid_t g = H5Gopen2(r->file, "/Parameters", H5P_DEFAULT);
   if (g < 0)
     return rfail(r, "/Parameters");
+  if (H5Lexists(g, "Keys", H5P_DEFAULT) > 0 && H5Lexists(g, "Values", H5P_DEFAULT) > 0) {
+    /* the datasets: in scene order, any number of keys */
+    size_t nk = 0, nv = 0;
+    char **k = NULL, **v = NULL;
+    int rc = read_strings(r, g, "Keys", &k, &nk);
+    if (!rc)
+      rc = read_strings(r, g, "Values", &v, &nv);
+    if (!rc && (nk != nv || nk > UINT_MAX)) {
+      set_err(r->err, r->errlen, "%s: /Parameters has %zu Keys and %zu Values", r->path, nk, nv);
+      rc = RHOD_ERR_READ;
+    }
+    if (rc) {
+      for (size_t i = 0; k && i < nk; i++)
+        free(k[i]);
+      for (size_t i = 0; v && i < nv; i++)
+        free(v[i]);
+      free(k);
+      free(v);
+    } else {
+      out->keys = k;
+      out->values = v;
+      out->n = (unsigned)nk;
+    }
+    H5Gclose(g);
+    return rc;
+  }
+  H5Eclear2(H5E_DEFAULT);
+  /* written before the datasets: one attribute per key */
   param_iter it = {out, 0, 0};
   hsize_t idx = 0;
   herr_t h = H5Aiterate2(g, H5_INDEX_CRT_ORDER, H5_ITER_INC, &idx, param_cb, &it);
