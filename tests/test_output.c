@@ -567,6 +567,31 @@ static int rm_entry(const char *path, const struct stat *sb, int flag, struct FT
   return remove(path);
 }
 
+/* A snapshot of an earlier version, with /Parameters as attributes only: read in order. */
+static void test_parameters_attributes_only(void) {
+  char *keys[] = {"time.end", "physics.gravity", "name"}, *vals[] = {"2", "[0, -9.81]", "z"};
+  rhod_param_list params = {keys, vals, 3};
+  particles P = make_particles(5);
+  rhod_snapshot_view v = view_of(&P, 0.0);
+  char err[512] = "";
+  CU_ASSERT_EQUAL_FATAL(rhod_write_snapshot(scratch, 2, &v, &params, err, sizeof err), RHOD_OK);
+  hid_t f = H5Fopen(spath("snapshot_0002.h5"), H5F_ACC_RDWR, H5P_DEFAULT);
+  CU_ASSERT_FATAL(f >= 0);
+  CU_ASSERT(H5Ldelete(f, "/Parameters/Keys", H5P_DEFAULT) >= 0);
+  CU_ASSERT(H5Ldelete(f, "/Parameters/Values", H5P_DEFAULT) >= 0);
+  H5Fclose(f);
+  rhod_snapshot_data d;
+  CU_ASSERT_EQUAL_FATAL(rhod_read_snapshot(spath("snapshot_0002.h5"), &d, err, sizeof err),
+                        RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(d.params.n, 3);
+  for (unsigned i = 0; i < 3; i++) {
+    CU_ASSERT_STRING_EQUAL(d.params.keys[i], keys[i]);
+    CU_ASSERT_STRING_EQUAL(d.params.values[i], vals[i]);
+  }
+  rhod_snapshot_data_free(&d);
+  free_particles(&P);
+}
+
 static void test_many_parameters(void) {
   many_parameters(20000);
   many_parameters(70000);
@@ -582,6 +607,7 @@ int main(void) {
   static const rhod_test_case cases[] = {
       {"units and provenance in every snapshot", test_units_and_provenance},
       {"20000 and 70000 parameters", test_many_parameters},
+      {"parameters of an older snapshot", test_parameters_attributes_only},
       {"xdmf: every field, vertex cells", test_xdmf_fields},
       {"walls file", test_walls_file},
       {"picture: walls and axes", test_picture_walls_axes},

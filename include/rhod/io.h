@@ -27,12 +27,13 @@ typedef struct {
 /* OUT/snapshot_NNNN.h5: /Header attrs Time, Dimension (2), NumPart; /PartType0 datasets
  * Coordinates, Velocities (N x 3, z = 0), Densities, Pressures, Masses, ParticleSizes,
  * ParticleIDs, FreeSurface (if fs); /Mesh/Vertices (N x 1, 0..N-1: the XDMF vertex
- * cells); /Parameters string attributes (dotted keys, in dense attribute storage: any
- * number of keys). Plain contiguous datasets, no filters. Stored as double whatever the
- * build precision. Every dataset has a string attribute Units: Coordinates "m",
- * Velocities "m/s", Densities "kg/m^3", Pressures "Pa", Masses "kg/m" (2D: per unit
- * depth), ParticleSizes "m", ParticleIDs, FreeSurface and Vertices "1". /Header also
- * carries the strings Code ("rhod"), Precision (RHOD_REAL_NAME), CodeVersion
+ * cells); /Parameters/Keys and /Parameters/Values (variable-length strings, the dotted
+ * keys in scene order, any number) and, up to 65535 keys, one string attribute per key
+ * on /Parameters (dense storage, creation order tracked). Plain contiguous datasets, no filters.
+ * Stored as double whatever the build precision. Every dataset has a string attribute Units:
+ * Coordinates "m", Velocities "m/s", Densities "kg/m^3", Pressures "Pa", Masses "kg/m" (2D: per
+ * unit depth), ParticleSizes "m", ParticleIDs, FreeSurface and Vertices "1", Keys and Values ""
+ * (text). /Header also carries the strings Code ("rhod"), Precision (RHOD_REAL_NAME), CodeVersion
  * (rhod_version()) and GitCommit (rhod_commit()).
  * The file is built in memory, then written through rhod_write_bytes_atomic.
  * Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"), RHOD_ERR_MEMORY. */
@@ -48,7 +49,8 @@ typedef struct {
   double *x, *y, *ux, *uy, *rho, *p, *m, *size;
   uint64_t *id;
   uint8_t *fs;            /* FreeSurface, NULL when the file has none */
-  rhod_param_list params; /* /Parameters in file order; owned here, freed by
+  rhod_param_list params; /* /Parameters (Keys and Values; in older files the attributes)
+                             in file order; owned here, freed by
                              rhod_snapshot_data_free (not rhod_param_list_free) */
 } rhod_snapshot_data;
 int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen);
