@@ -6,10 +6,13 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "rhod/io.h"
+#include "rhod/version.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <hdf5.h>
+#include <limits.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -131,9 +134,9 @@ static int write_str_attr(h5_reason *R, hid_t loc, const char *name, const char 
 }
 
 /* A contiguous (default creation properties: no chunks, no filters) dataset of rank 1
- * (cols == 0) or n x cols. */
+ * (cols == 0) or n x cols, with a string attribute Units (SI, "1" for a number). */
 static int write_dataset(h5_reason *R, hid_t loc, const char *name, hid_t ftype, hid_t mtype,
-                         size_t n, unsigned cols, const void *buf) {
+                         size_t n, unsigned cols, const void *buf, const char *units) {
   hsize_t dims[2] = {(hsize_t)n, (hsize_t)cols};
   hid_t sp = H5Screate_simple(cols ? 2 : 1, dims, NULL);
   if (sp < 0) {
@@ -157,6 +160,8 @@ static int write_dataset(h5_reason *R, hid_t loc, const char *name, hid_t ftype,
       note(R);
       rc = -1;
     }
+    if (!rc && write_str_attr(R, d, "Units", units) < 0)
+      rc = -1;
     if (H5Dclose(d) < 0) {
       note(R);
       rc = -1;
@@ -207,24 +212,49 @@ static int write_particles(h5_reason *R, hid_t file, const rhod_snapshot_view *v
   const hid_t F = H5T_IEEE_F64LE, M = H5T_NATIVE_DOUBLE;
   size_t n = v->n;
   pack_xyz(buf, v->x, v->y, n);
-  int rc = write_dataset(R, g, "Coordinates", F, M, n, 3, buf);
+  int rc = write_dataset(R, g, "Coordinates", F, M, n, 3, buf, "m");
   if (!rc) {
     pack_xyz(buf, v->ux, v->uy, n);
-    rc = write_dataset(R, g, "Velocities", F, M, n, 3, buf);
+    rc = write_dataset(R, g, "Velocities", F, M, n, 3, buf, "m/s");
   }
   struct {
     const char *name;
     const real *a;
-  } scalars[] = {
-      {"Densities", v->rho}, {"Pressures", v->p}, {"Masses", v->m}, {"ParticleSizes", v->size}};
+    const char *units;
+  } scalars[] = {{"Densities", v->rho, "kg/m^3"},
+                 {"Pressures", v->p, "Pa"},
+                 {"Masses", v->m, "kg/m"}, /* 2D: mass per unit depth */
+                 {"ParticleSizes", v->size, "m"}};
   for (size_t k = 0; k < sizeof scalars / sizeof scalars[0] && !rc; k++) {
     to_double(buf, scalars[k].a, n);
-    rc = write_dataset(R, g, scalars[k].name, F, M, n, 0, buf);
+    rc = write_dataset(R, g, scalars[k].name, F, M, n, 0, buf, scalars[k].units);
   }
   if (!rc)
-    rc = write_dataset(R, g, "ParticleIDs", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 0, v->id);
+    rc = write_dataset(R, g, "ParticleIDs", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 0, v->id, "1");
   if (!rc && v->fs)
-    rc = write_dataset(R, g, "FreeSurface", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, v->fs);
+    rc = write_dataset(R, g, "FreeSurface", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, v->fs, "1");
+  return close_group(R, g, rc);
+}
+
+/* /Mesh/Vertices: N x 1 indices 0..N-1, one vertex cell per particle, the connectivity
+ * of the XDMF Polyvertex topology (io_xdmf.c): readers that need explicit cells (meshio,
+ * ParaView's Xdmf3 readers) get one cell per particle. 4-byte indices while N fits. */
+static int write_mesh(h5_reason *R, hid_t file, size_t n, void *buf) {
+  hid_t g = create_group(R, file, "Mesh", H5P_DEFAULT);
+  if (g < 0)
+    return -1;
+  int rc;
+  if (n <= UINT32_MAX) {
+    uint32_t *ix = buf;
+    for (size_t i = 0; i < n; i++)
+      ix[i] = (uint32_t)i;
+    rc = write_dataset(R, g, "Vertices", H5T_STD_U32LE, H5T_NATIVE_UINT32, n, 1, ix, "1");
+  } else {
+    uint64_t *ix = buf;
+    for (size_t i = 0; i < n; i++)
+      ix[i] = (uint64_t)i;
+    rc = write_dataset(R, g, "Vertices", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 1, ix, "1");
+  }
   return close_group(R, g, rc);
 }
 
@@ -243,17 +273,51 @@ static int write_header(h5_reason *R, hid_t file, const rhod_snapshot_view *v) {
     rc = write_str_attr(R, g, "Code", "rhod");
   if (!rc)
     rc = write_str_attr(R, g, "Precision", RHOD_REAL_NAME);
+  if (!rc)
+    rc = write_str_attr(R, g, "CodeVersion", rhod_version());
+  if (!rc)
+    rc = write_str_attr(R, g, "GitCommit", rhod_commit());
   return close_group(R, g, rc);
 }
 
-static int write_params(h5_reason *R, hid_t file, const rhod_param_list *params) {
-  /* Creation order is tracked so that a reader gets the keys back in scene order. */
+/* HDF5 numbers an object's attributes in creation order with 16 bits: past this many, a
+ * group cannot track their order ("attribute creation index can't be incremented"). */
+#define MAX_TRACKED_ATTRS 65535u
+
+/* A 1D dataset of variable-length strings (NULL written as ""). */
+static int write_strings(h5_reason *R, hid_t loc, const char *name, char *const *s, unsigned n) {
+  const char **v = malloc((n ? n : 1) * sizeof *v);
+  if (!v)
+    return -2;
+  for (unsigned i = 0; i < n; i++)
+    v[i] = s[i] ? s[i] : "";
+  hid_t t = H5Tcopy(H5T_C_S1);
+  int rc = -1;
+  if (t >= 0 && H5Tset_size(t, H5T_VARIABLE) >= 0)
+    rc = write_dataset(R, loc, name, t, t, n, 0, v, "");
+  else
+    note(R);
+  if (t >= 0)
+    H5Tclose(t);
+  free(v);
+  return rc;
+}
+
+/* /Parameters: the scene as run, as two datasets Keys and Values (variable-length strings,
+ * in scene order: any number of keys) and, for h5py's f["Parameters"].attrs and older
+ * readers, one string attribute per key, in creation order, while there are at most
+ * 65535 keys (HDF5's limit for a tracked order; without it, HDF5 1.10 takes minutes to
+ * add that many). The attributes are kept in dense storage (a heap and B-trees beside
+ * the group): compact storage in the group's object header overflows at 64 KiB. */
+static int write_params(h5_reason *R, hid_t file, const rhod_param_list *params, int *oom) {
+  const unsigned n = params ? params->n : 0;
   hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
   if (gcpl < 0) {
     note(R);
     return -1;
   }
-  if (H5Pset_attr_creation_order(gcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0) {
+  if (H5Pset_attr_creation_order(gcpl, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0 ||
+      H5Pset_attr_phase_change(gcpl, 0, 0) < 0) {
     note(R);
     H5Pclose(gcpl);
     return -1;
@@ -263,27 +327,19 @@ static int write_params(h5_reason *R, hid_t file, const rhod_param_list *params)
   if (g < 0)
     return -1;
   int rc = 0;
-  for (unsigned i = 0; params && i < params->n && !rc; i++)
+  for (unsigned i = 0; n <= MAX_TRACKED_ATTRS && i < n && !rc; i++)
     rc = write_str_attr(R, g, params->keys[i], params->values[i] ? params->values[i] : "");
+  if (!rc)
+    rc = write_strings(R, g, "Keys", n ? params->keys : NULL, n);
+  if (!rc)
+    rc = write_strings(R, g, "Values", n ? params->values : NULL, n);
+  if (rc == -2)
+    *oom = 1;
   return close_group(R, g, rc);
 }
 
-/* Builds the whole file in memory (core driver, no backing store) and returns its image.
- * HDF5 never touches the disk, so a full disk cannot leave a half-closed HDF5 file behind
- * (HDF5 1.10 keeps such a file open and crashes at exit); the image is then written with
- * rhod_write_bytes_atomic, whose errors are plain errno values. */
-static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_view *v,
-                         const rhod_param_list *params, size_t *size, int *oom) {
-  *size = 0;
-  *oom = 0;
-  size_t n = v->n;
-  double *buf = malloc(3 * (n ? n : 1) * sizeof *buf);
-  if (!buf) {
-    *oom = 1;
-    return NULL;
-  }
-  /* one allocation of the core driver for the whole file, most of the time */
-  size_t increment = n * (6 * sizeof(double) + 4 * sizeof(double) + 9) + (1u << 16);
+/* An HDF5 file in memory (core driver, no backing store, growing by `increment`). */
+static hid_t core_file(h5_reason *R, const char *name, size_t increment) {
   hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
   hid_t file = -1;
   if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0 &&
@@ -293,15 +349,14 @@ static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_vie
     note(R);
   if (fapl >= 0)
     H5Pclose(fapl);
-  int bad = file < 0;
-  if (!bad)
-    bad = write_header(R, file, v) != 0;
-  if (!bad)
-    bad = write_particles(R, file, v, buf) != 0;
-  free(buf);
-  if (!bad)
-    bad = write_params(R, file, params) != 0;
+  return file;
+}
+
+/* Closes an in-memory file and returns its image (NULL on failure, *oom set when out of
+ * memory); bad: the file's content failed already (close it only). */
+static void *close_image(h5_reason *R, hid_t file, int bad, size_t *size, int *oom) {
   void *image = NULL;
+  *size = 0;
   if (!bad && H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) {
     note(R);
     bad = 1;
@@ -326,6 +381,38 @@ static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_vie
     image = NULL;
   }
   return image;
+}
+
+/* Builds the whole file in memory (core driver, no backing store) and returns its image.
+ * HDF5 never touches the disk, so a full disk cannot leave a half-closed HDF5 file behind
+ * (HDF5 1.10 keeps such a file open and crashes at exit); the image is then written with
+ * rhod_write_bytes_atomic, whose errors are plain errno values. */
+static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_view *v,
+                         const rhod_param_list *params, size_t *size, int *oom) {
+  *size = 0;
+  *oom = 0;
+  size_t n = v->n;
+  double *buf = malloc(3 * (n ? n : 1) * sizeof *buf);
+  if (!buf) {
+    *oom = 1;
+    return NULL;
+  }
+  /* one allocation of the core driver for the whole file, most of the time */
+  size_t increment = n * (6 * sizeof(double) + 4 * sizeof(double) + 9 + 8) + (1u << 16);
+  hid_t file = core_file(R, name, increment);
+  int bad = file < 0;
+  if (!bad)
+    bad = write_header(R, file, v) != 0;
+  if (!bad)
+    bad = write_particles(R, file, v, buf) != 0;
+  if (!bad)
+    bad = write_mesh(R, file, n, buf) != 0;
+  free(buf);
+  if (!bad)
+    bad = write_params(R, file, params, oom) != 0;
+  if (file < 0)
+    return NULL;
+  return close_image(R, file, bad, size, oom);
 }
 
 int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
@@ -365,6 +452,182 @@ int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
   H5Eclear2(H5E_DEFAULT);
   free(image);
   free(path);
+  return rc;
+}
+
+/* ---------------------------------------------------------------- walls */
+
+unsigned rhod_shape_outline(const rhod_shape *sh, unsigned circle_segments, double (*out)[2]) {
+  switch (sh->kind) {
+  case RHOD_SHAPE_RECT:
+    if (out) {
+      const double c[4][2] = {{sh->min[0], sh->min[1]},
+                              {sh->max[0], sh->min[1]},
+                              {sh->max[0], sh->max[1]},
+                              {sh->min[0], sh->max[1]}};
+      memcpy(out, c, sizeof c);
+    }
+    return 4;
+  case RHOD_SHAPE_POLYGON:
+    if (out && sh->n_points)
+      memcpy(out, sh->points, sizeof(double[2]) * sh->n_points);
+    return sh->n_points;
+  case RHOD_SHAPE_CIRCLE: {
+    const unsigned n = circle_segments < 8 ? 8 : circle_segments;
+    const double two_pi = 6.283185307179586476925286766559;
+    for (unsigned k = 0; out && k < n; k++) {
+      out[k][0] = sh->center[0] + sh->radius * cos(two_pi * k / n);
+      out[k][1] = sh->center[1] + sh->radius * sin(two_pi * k / n);
+    }
+    return n;
+  }
+  }
+  return 0;
+}
+
+/* Segments of a circle of radius r: no longer than dx/4, 64 to 65536. */
+static unsigned circle_segments(double r, double dx) {
+  double n = dx > 0 ? ceil(6.283185307179586 * r / (0.25 * dx)) : 64;
+  if (!(n >= 64))
+    n = 64;
+  if (n > 65536)
+    n = 65536;
+  return (unsigned)n;
+}
+
+static const char WALLS_XDMF[] =
+    "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+    "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+    "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+    "  <Domain>\n"
+    "    <Grid Name=\"walls\" GridType=\"Uniform\">\n"
+    "      <Topology TopologyType=\"Polyline\" NumberOfElements=\"%zu\" NodesPerElement=\"2\">\n"
+    "        <DataItem Dimensions=\"%zu 2\" NumberType=\"UInt\" Precision=\"4\" "
+    "Format=\"HDF\">walls.h5:/Walls/Segments</DataItem>\n"
+    "      </Topology>\n"
+    "      <Geometry GeometryType=\"XYZ\">\n"
+    "        <DataItem Dimensions=\"%zu 3\" NumberType=\"Float\" Precision=\"8\" "
+    "Format=\"HDF\">walls.h5:/Walls/Points</DataItem>\n"
+    "      </Geometry>\n"
+    "      <Attribute Name=\"WallIndex\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
+    "        <DataItem Dimensions=\"%zu\" NumberType=\"UInt\" Precision=\"4\" "
+    "Format=\"HDF\">walls.h5:/Walls/WallIndex</DataItem>\n"
+    "      </Attribute>\n"
+    "    </Grid>\n"
+    "  </Domain>\n"
+    "</Xdmf>\n";
+
+int rhod_write_walls(const char *dir, const rhod_scene *sc, char *err, size_t errlen) {
+  char *h5 = join_path(dir, "walls.h5"), *xdmf = join_path(dir, "walls.xdmf");
+  if (!h5 || !xdmf) {
+    free(h5);
+    free(xdmf);
+    set_err(err, errlen, "walls.h5: cannot write: out of memory");
+    return RHOD_ERR_MEMORY;
+  }
+  int rc = RHOD_OK;
+  if (sc->n_walls == 0) {
+    /* none: no empty grid for readers to choke on; no file left from an earlier run */
+    const char *paths[2] = {xdmf, h5};
+    for (int k = 0; k < 2 && !rc; k++)
+      if (remove(paths[k]) != 0 && errno != ENOENT) {
+        set_err(err, errlen, "%s: cannot remove: %s", paths[k], strerror(errno));
+        rc = RHOD_ERR_IO;
+      }
+    free(h5);
+    free(xdmf);
+    return rc;
+  }
+  size_t np = 0;
+  for (unsigned w = 0; w < sc->n_walls; w++)
+    np += rhod_shape_outline(&sc->walls[w].shape,
+                             circle_segments(sc->walls[w].shape.radius, sc->dx), NULL);
+  double *pts = malloc(sizeof(double) * 3 * np);
+  double(*ring)[2] = malloc(sizeof(double[2]) * np);
+  uint32_t *seg = malloc(sizeof(uint32_t) * 2 * np), *widx = malloc(sizeof(uint32_t) * np);
+  uint8_t *inside = malloc(sc->n_walls);
+  if (!pts || !ring || !seg || !widx || !inside || np > UINT32_MAX) {
+    set_err(err, errlen, "%s: cannot write: out of memory", h5);
+    rc = RHOD_ERR_MEMORY;
+    goto done;
+  }
+  /* each wall a closed ring: its points, then segments k -> k+1 and last -> first */
+  size_t at = 0;
+  for (unsigned w = 0; w < sc->n_walls; w++) {
+    const rhod_shape *sh = &sc->walls[w].shape;
+    unsigned m = rhod_shape_outline(sh, circle_segments(sh->radius, sc->dx), ring);
+    for (unsigned k = 0; k < m; k++) {
+      pts[3 * (at + k)] = ring[k][0];
+      pts[3 * (at + k) + 1] = ring[k][1];
+      pts[3 * (at + k) + 2] = 0.0;
+      seg[2 * (at + k)] = (uint32_t)(at + k);
+      seg[2 * (at + k) + 1] = (uint32_t)(at + (k + 1) % m);
+      widx[at + k] = w;
+    }
+    inside[w] = (uint8_t)(sc->walls[w].fluid_inside != 0);
+    at += m;
+  }
+  h5_quiet();
+  h5_reason R = {0, 0, 0, ""};
+  hid_t file = core_file(&R, h5, np * 40 + (1u << 16));
+  int bad = file < 0;
+  if (!bad) {
+    hid_t g = create_group(&R, file, "Header", H5P_DEFAULT);
+    bad = g < 0;
+    if (!bad) {
+      uint32_t nw = sc->n_walls;
+      int r = write_attr(&R, g, "NumWalls", H5T_STD_U32LE, H5T_NATIVE_UINT32, &nw);
+      if (!r)
+        r = write_str_attr(&R, g, "Code", "rhod");
+      if (!r)
+        r = write_str_attr(&R, g, "CodeVersion", rhod_version());
+      if (!r)
+        r = write_str_attr(&R, g, "GitCommit", rhod_commit());
+      bad = close_group(&R, g, r) != 0;
+    }
+  }
+  if (!bad) {
+    hid_t g = create_group(&R, file, "Walls", H5P_DEFAULT);
+    bad = g < 0;
+    if (!bad) {
+      int r = write_dataset(&R, g, "Points", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, np, 3, pts, "m");
+      if (!r)
+        r = write_dataset(&R, g, "Segments", H5T_STD_U32LE, H5T_NATIVE_UINT32, np, 2, seg, "1");
+      if (!r)
+        r = write_dataset(&R, g, "WallIndex", H5T_STD_U32LE, H5T_NATIVE_UINT32, np, 0, widx, "1");
+      if (!r)
+        r = write_dataset(&R, g, "FluidInside", H5T_STD_U8LE, H5T_NATIVE_UINT8, sc->n_walls, 0,
+                          inside, "1");
+      bad = close_group(&R, g, r) != 0;
+    }
+  }
+  size_t size = 0;
+  int oom = 0;
+  void *image = file < 0 ? NULL : close_image(&R, file, bad, &size, &oom);
+  H5Eclear2(H5E_DEFAULT);
+  if (!image) {
+    char reason[200] = "out of memory";
+    if (!oom)
+      reason_text(&R, reason, sizeof reason);
+    set_err(err, errlen, "%s: cannot write: %s", h5, reason);
+    rc = oom ? RHOD_ERR_MEMORY : RHOD_ERR_IO;
+    goto done;
+  }
+  rc = rhod_write_bytes_atomic(h5, image, size, err, errlen);
+  free(image);
+  if (rc == RHOD_OK) {
+    char text[sizeof WALLS_XDMF + 96];
+    snprintf(text, sizeof text, WALLS_XDMF, np, np, np, np);
+    rc = rhod_write_file_atomic(xdmf, text, err, errlen);
+  }
+done:
+  free(pts);
+  free(ring);
+  free(seg);
+  free(widx);
+  free(inside);
+  free(h5);
+  free(xdmf);
   return rc;
 }
 
@@ -533,6 +796,70 @@ static herr_t param_cb(hid_t loc, const char *name, const H5A_info_t *info, void
   return 0;
 }
 
+/* A 1D dataset of strings (variable or fixed length) into malloc'd strings; *n its
+ * length. Returns RHOD_OK, RHOD_ERR_READ or RHOD_ERR_MEMORY. */
+static int read_strings(reader *r, hid_t g, const char *name, char ***out, size_t *n) {
+  char what[64];
+  snprintf(what, sizeof what, "/Parameters/%s", name);
+  *out = NULL;
+  *n = 0;
+  hid_t d = H5Dopen2(g, name, H5P_DEFAULT);
+  if (d < 0)
+    return rfail(r, what);
+  hid_t sp = H5Dget_space(d), ft = H5Dget_type(d);
+  hsize_t dims[1] = {0};
+  int rc = RHOD_OK;
+  if (sp < 0 || ft < 0 || H5Sget_simple_extent_ndims(sp) != 1 || H5Tget_class(ft) != H5T_STRING ||
+      H5Tis_variable_str(ft) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen, "%s: %s is not a list of variable-length strings", r->path, what);
+    rc = RHOD_ERR_READ;
+  }
+  if (!rc)
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+  size_t len = (size_t)dims[0];
+  char **raw = rc ? NULL : calloc(len ? len : 1, sizeof *raw);
+  char **copy = rc ? NULL : calloc(len ? len : 1, sizeof *copy);
+  hid_t mt = -1;
+  if (!rc && (!raw || !copy))
+    rc = RHOD_ERR_MEMORY;
+  if (!rc) {
+    mt = H5Tcopy(H5T_C_S1);
+    if (mt < 0 || H5Tset_size(mt, H5T_VARIABLE) < 0 ||
+        (len && H5Dread(d, mt, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw) < 0))
+      rc = rfail(r, what);
+  }
+  for (size_t i = 0; !rc && i < len; i++)
+    if (!(copy[i] = strdup(raw[i] ? raw[i] : "")))
+      rc = RHOD_ERR_MEMORY;
+  if (mt >= 0 && raw && len) {
+#if H5_VERSION_GE(1, 12, 0)
+    H5Treclaim(mt, sp, H5P_DEFAULT, raw);
+#else
+    H5Dvlen_reclaim(mt, sp, H5P_DEFAULT, raw);
+#endif
+  }
+  if (mt >= 0)
+    H5Tclose(mt);
+  free(raw);
+  if (rc == RHOD_ERR_MEMORY)
+    set_err(r->err, r->errlen, "%s: out of memory reading %s", r->path, what);
+  if (rc) {
+    for (size_t i = 0; copy && i < len; i++)
+      free(copy[i]);
+    free(copy);
+  } else {
+    *out = copy;
+    *n = len;
+  }
+  if (ft >= 0)
+    H5Tclose(ft);
+  if (sp >= 0)
+    H5Sclose(sp);
+  H5Dclose(d);
+  return rc;
+}
+
 static int read_params(reader *r, rhod_param_list *out) {
   if (H5Lexists(r->file, "/Parameters", H5P_DEFAULT) <= 0) {
     H5Eclear2(H5E_DEFAULT);
@@ -541,6 +868,34 @@ static int read_params(reader *r, rhod_param_list *out) {
   hid_t g = H5Gopen2(r->file, "/Parameters", H5P_DEFAULT);
   if (g < 0)
     return rfail(r, "/Parameters");
+  if (H5Lexists(g, "Keys", H5P_DEFAULT) > 0 && H5Lexists(g, "Values", H5P_DEFAULT) > 0) {
+    /* the datasets: in scene order, any number of keys */
+    size_t nk = 0, nv = 0;
+    char **k = NULL, **v = NULL;
+    int rc = read_strings(r, g, "Keys", &k, &nk);
+    if (!rc)
+      rc = read_strings(r, g, "Values", &v, &nv);
+    if (!rc && (nk != nv || nk > UINT_MAX)) {
+      set_err(r->err, r->errlen, "%s: /Parameters has %zu Keys and %zu Values", r->path, nk, nv);
+      rc = RHOD_ERR_READ;
+    }
+    if (rc) {
+      for (size_t i = 0; k && i < nk; i++)
+        free(k[i]);
+      for (size_t i = 0; v && i < nv; i++)
+        free(v[i]);
+      free(k);
+      free(v);
+    } else {
+      out->keys = k;
+      out->values = v;
+      out->n = (unsigned)nk;
+    }
+    H5Gclose(g);
+    return rc;
+  }
+  H5Eclear2(H5E_DEFAULT);
+  /* written before the datasets: one attribute per key */
   param_iter it = {out, 0, 0};
   hsize_t idx = 0;
   herr_t h = H5Aiterate2(g, H5_INDEX_CRT_ORDER, H5_ITER_INC, &idx, param_cb, &it);

@@ -3,11 +3,13 @@
  * run as a time series of particles with their fields. Rewritten atomically after each
  * snapshot.
  *
- * The layout follows SWIFT's .xmf files (XDMF 2): the Polyvertex topology has no
- * connectivity array, so ParaView's "XDMF Reader" gives every particle its own vertex
- * cell (Xdmf2's default connectivity 0..N-1). The Xdmf3 readers load the same points
- * and fields without cells: use the Point Gaussian representation there. Particle ids
- * are declared as 8-byte Int, as SWIFT does, which every XDMF reader maps. */
+ * XDMF 3 (meshio's time-series reader needs Version 3; ParaView's Xdmf3 readers and its
+ * legacy "XDMF Reader" read it too). The Polyvertex topology has explicit connectivity,
+ * /Mesh/Vertices of the snapshot (0..N-1, N x 1): without it the Xdmf3 readers make no
+ * cells and ParaView's default representation shows nothing. Attribute names are
+ * singular (Velocity, Pressure, ...), their units those of the datasets' Units
+ * attributes (docs/scene.md). Particle ids are declared as 8-byte Int, as SWIFT does,
+ * which every XDMF reader maps. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "rhod/io.h"
@@ -16,48 +18,57 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* One DataItem pointing into /PartType0 of a snapshot (path relative to the XDMF file). */
+unsigned rhod_snapshot_fields(const rhod_snapshot_view *v) {
+  return v && v->fs ? RHOD_FIELDS_FREE_SURFACE : 0u;
+}
+
+/* One DataItem pointing into a snapshot (path relative to the XDMF file). */
 static void data_item(FILE *f, const char *file, const char *dataset, size_t n, int cols,
-                      const char *type) {
+                      const char *type, int precision) {
   if (cols)
     fprintf(f, "          <DataItem Dimensions=\"%zu %d\" ", n, cols);
   else
     fprintf(f, "          <DataItem Dimensions=\"%zu\" ", n);
-  fprintf(f, "NumberType=\"%s\" Precision=\"8\" Format=\"HDF\">%s:/PartType0/%s</DataItem>\n", type,
-          file, dataset);
+  fprintf(f, "NumberType=\"%s\" Precision=\"%d\" Format=\"HDF\">%s:%s</DataItem>\n", type,
+          precision, file, dataset);
 }
 
 static void attribute(FILE *f, const char *file, const char *name, const char *dataset, size_t n,
-                      int vector, const char *type) {
+                      int vector, const char *type, int precision) {
   fprintf(f, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", name,
           vector ? "Vector" : "Scalar");
-  data_item(f, file, dataset, n, vector ? 3 : 0, type);
+  data_item(f, file, dataset, n, vector ? 3 : 0, type, precision);
   fprintf(f, "        </Attribute>\n");
 }
 
-static void grid(FILE *f, int index, double time, size_t n) {
+static void grid(FILE *f, int index, double time, size_t n, unsigned fields) {
   char file[64];
   snprintf(file, sizeof file, "snapshot_%04d.h5", index);
   fprintf(f, "      <Grid Name=\"snapshot_%04d\" GridType=\"Uniform\">\n", index);
   fprintf(f, "        <Time Value=\"%.15g\"/>\n", time);
   fprintf(f,
           "        <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
-          "NodesPerElement=\"1\"/>\n",
+          "NodesPerElement=\"1\">\n",
           n);
+  /* 4-byte indices while N fits (io_hdf5.c, write_mesh) */
+  data_item(f, file, "/Mesh/Vertices", n, 1, "UInt", n <= UINT32_MAX ? 4 : 8);
+  fprintf(f, "        </Topology>\n");
   fprintf(f, "        <Geometry GeometryType=\"XYZ\">\n");
-  data_item(f, file, "Coordinates", n, 3, "Float");
+  data_item(f, file, "/PartType0/Coordinates", n, 3, "Float", 8);
   fprintf(f, "        </Geometry>\n");
-  attribute(f, file, "Velocity", "Velocities", n, 1, "Float");
-  attribute(f, file, "Density", "Densities", n, 0, "Float");
-  attribute(f, file, "Pressure", "Pressures", n, 0, "Float");
-  attribute(f, file, "Mass", "Masses", n, 0, "Float");
-  attribute(f, file, "ParticleSize", "ParticleSizes", n, 0, "Float");
-  attribute(f, file, "ParticleID", "ParticleIDs", n, 0, "Int");
+  attribute(f, file, "Velocity", "/PartType0/Velocities", n, 1, "Float", 8);
+  attribute(f, file, "Density", "/PartType0/Densities", n, 0, "Float", 8);
+  attribute(f, file, "Pressure", "/PartType0/Pressures", n, 0, "Float", 8);
+  attribute(f, file, "Mass", "/PartType0/Masses", n, 0, "Float", 8);
+  attribute(f, file, "ParticleSize", "/PartType0/ParticleSizes", n, 0, "Float", 8);
+  attribute(f, file, "ParticleID", "/PartType0/ParticleIDs", n, 0, "Int", 8);
+  if (fields & RHOD_FIELDS_FREE_SURFACE)
+    attribute(f, file, "FreeSurface", "/PartType0/FreeSurface", n, 0, "UChar", 1);
   fprintf(f, "      </Grid>\n");
 }
 
 int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
-                    char *err, size_t errlen) {
+                    unsigned fields, char *err, size_t errlen) {
   size_t dl = dir ? strlen(dir) : 0;
   const char *name = "snapshots.xdmf";
   char *path = malloc(dl + strlen(name) + 2);
@@ -82,12 +93,12 @@ int rhod_write_xdmf(const char *dir, int count, const double *times, const size_
   }
   fprintf(f, "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
              "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-             "<Xdmf Version=\"2.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+             "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
              "  <Domain>\n"
              "    <Grid Name=\"particles\" GridType=\"Collection\" "
              "CollectionType=\"Temporal\">\n");
   for (int i = 0; i < count; i++)
-    grid(f, i, times[i], nparts[i]);
+    grid(f, i, times[i], nparts[i], fields);
   fprintf(f, "    </Grid>\n"
              "  </Domain>\n"
              "</Xdmf>\n");

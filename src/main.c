@@ -5,6 +5,7 @@
 #include "rhod/scene.h"
 #include "rhod/schedule.h"
 #include "rhod/sim.h"
+#include "rhod/version.h"
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -433,7 +434,7 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   c->snap_t[c->nsnap] = s->t;
   c->snap_n[c->nsnap] = s->p.n;
   c->nsnap++;
-  st = rhod_write_xdmf(c->out, c->nsnap, c->snap_t, c->snap_n, err, len);
+  st = rhod_write_xdmf(c->out, c->nsnap, c->snap_t, c->snap_n, rhod_snapshot_fields(&v), err, len);
   if (st != RHOD_OK)
     return st;
   const rhod_scene *sc = c->sc;
@@ -444,7 +445,8 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   const double *lo = sc->picture_box_set ? sc->picture_box_min : s->lo;
   const double *hi = sc->picture_box_set ? sc->picture_box_max : s->hi;
   st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_size_panel, sc->picture_width, lo,
-                          hi, sc->picture_range_set ? sc->picture_range : NULL, err, len);
+                          hi, sc->picture_range_set ? sc->picture_range : NULL, sc->walls,
+                          sc->n_walls, err, len);
   return st;
 }
 
@@ -654,6 +656,8 @@ static int run(run_opts *o, const char *resume_out) {
     st = prepare_output(out, resume_out != NULL, o->overwrite, &lockfd, err, sizeof err);
   if (st == RHOD_OK && resume_out)
     st = check_resume_files(out, &ck, &missing, err, sizeof err);
+  if (st == RHOD_OK)
+    st = rhod_write_walls(out, c.sc, err, sizeof err);
   if (st != RHOD_OK) {
     report("%s", err);
     rhod_sim_free(&c.sim);
@@ -1111,7 +1115,7 @@ int main(int argc, char **argv) {
     return cmd_help(argc == 3 ? argv[2] : NULL);
   }
   if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
-    printf("rhod 0.1 (%s precision, %s)\n", RHOD_REAL_NAME,
+    printf("rhod %s (commit %s, %s precision, %s)\n", rhod_version(), rhod_commit(), RHOD_REAL_NAME,
 #ifdef RHOD_OFFLOAD
            "nvptx offload"
 #else

@@ -1,8 +1,10 @@
 /* PNG pictures of one particle field: each particle a filled disc of its own size in the
- * frame [lo, hi] (y up), coloured by viridis; below the frame a strip with the colour bar,
- * its range and the time in a built-in 5x7 bitmap font. Optionally a second panel below,
- * the same frame coloured by particle size (log scale). Encoded by libpng (simplified
- * API, into memory) and written through rhod_write_bytes_atomic. */
+ * frame [lo, hi] (y up), coloured by viridis; the walls as dark 2-pixel lines inside the
+ * frame; axes with tick labels in metres along the frame's left and bottom edges; below
+ * them a strip with the colour bar, its range, the field's name and unit and the time, in
+ * a built-in 5x7 bitmap font. Optionally a second panel below, the same frame coloured by
+ * particle size (log scale). Encoded by libpng (simplified API, into memory) and written
+ * through rhod_write_bytes_atomic. */
 #include "rhod/io.h"
 
 #include <math.h>
@@ -87,6 +89,16 @@ static const glyph font[] = {
     {'t', {0x08, 0x08, 0x1C, 0x08, 0x08, 0x09, 0x06}},
     {'u', {0x00, 0x00, 0x11, 0x11, 0x11, 0x13, 0x0D}},
     {'z', {0x00, 0x00, 0x1F, 0x02, 0x04, 0x08, 0x1F}},
+    {'c', {0x00, 0x00, 0x0E, 0x10, 0x10, 0x11, 0x0E}},
+    {'k', {0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12}},
+    {'m', {0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11}},
+    {'x', {0x00, 0x00, 0x11, 0x0A, 0x04, 0x0A, 0x11}},
+    {'y', {0x00, 0x00, 0x11, 0x11, 0x0F, 0x01, 0x0E}},
+    {'P', {0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10}},
+    {'[', {0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E}},
+    {']', {0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E}},
+    {'/', {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}},
+    {'^', {0x04, 0x0A, 0x11, 0x00, 0x00, 0x00, 0x00}},
 };
 
 static long text_width(const char *s, int scale) {
@@ -94,14 +106,18 @@ static long text_width(const char *s, int scale) {
   return n ? (long)n * 6 * scale - scale : 0;
 }
 
+static const glyph *glyph_of(char ch) {
+  for (size_t k = 0; k < sizeof font / sizeof font[0]; k++)
+    if (font[k].ch == ch)
+      return &font[k];
+  return NULL;
+}
+
 /* Draws s with its top-left corner at (x, y); characters without a glyph are blanks. */
 static void draw_text(canvas *c, long x, long y, int scale, const char *s) {
   static const unsigned char ink[3] = {0, 0, 0};
   for (; *s; s++, x += 6 * scale) {
-    const glyph *g = NULL;
-    for (size_t k = 0; k < sizeof font / sizeof font[0]; k++)
-      if (font[k].ch == *s)
-        g = &font[k];
+    const glyph *g = glyph_of(*s);
     if (!g)
       continue;
     for (int r = 0; r < 7; r++)
@@ -113,20 +129,38 @@ static void draw_text(canvas *c, long x, long y, int scale, const char *s) {
   }
 }
 
+/* The same turned a quarter left, read from bottom to top: the letters' tops face
+ * left; (x, y) is the bottom-left corner of the turned text. */
+static void draw_text_up(canvas *c, long x, long y, int scale, const char *s) {
+  static const unsigned char ink[3] = {0, 0, 0};
+  for (long i = 0; *s; s++, i++) {
+    const glyph *g = glyph_of(*s);
+    if (!g)
+      continue;
+    for (int r = 0; r < 7; r++)
+      for (int col = 0; col < 5; col++)
+        if (g->rows[r] & (0x10 >> col))
+          for (int dy = 0; dy < scale; dy++)
+            for (int dx = 0; dx < scale; dx++)
+              put(c, x + r * scale + dx, y - 1 - ((i * 6 + col) * scale + dy), ink);
+  }
+}
+
 /* ------------------------------------------------------------ particles */
 
+/* The colour bar's label: the field's name and its unit. */
 static const char *field_label(rhod_field f) {
   switch (f) {
   case RHOD_FIELD_PRESSURE:
-    return "p";
+    return "p [Pa]";
   case RHOD_FIELD_VELOCITY:
-    return "|u|";
+    return "|u| [m/s]";
   case RHOD_FIELD_DENSITY:
-    return "rho";
+    return "rho [kg/m^3]";
   case RHOD_FIELD_SIZE:
-    return "size";
+    return "size [m]";
   case RHOD_FIELD_FREE_SURFACE:
-    return "fs";
+    return "free surface [1]";
   }
   return "";
 }
@@ -211,32 +245,301 @@ static double scale_at(rhod_field field, double f, double vmin, double vmax) {
   return vmax != vmin ? (f - vmin) / (vmax - vmin) : 0.0;
 }
 
-/* One panel at rows [y_off, y_off + fh + strip): the particles coloured by `field` in the
- * frame [lo, hi], a grey rule, the colour bar and "min  field  t=...s  max". */
-static void draw_panel(canvas *c, long y_off, unsigned fh, int scale, const rhod_snapshot_view *v,
-                       rhod_field field, const double lo[2], const double hi[2],
-                       const double *range) {
-  const unsigned width = c->w;
-  /* Field values and their range. */
+int rhod_picture_field_range(const rhod_snapshot_view *v, rhod_field f, double range[2]) {
+  range[0] = range[1] = 0.0;
+  if (!v || (v->n > 0 && !field_present(v, f)) || (f == RHOD_FIELD_SIZE && v->n > 0 && !v->size))
+    return -1;
+  int any = 0;
+  for (size_t i = 0; i < v->n; i++) {
+    double x = field_value(v, f, i);
+    if (!isfinite(x))
+      continue;
+    if (!any || x < range[0])
+      range[0] = x;
+    if (!any || x > range[1])
+      range[1] = x;
+    any = 1;
+  }
+  return any ? 0 : -1;
+}
+
+/* ------------------------------------------------------------ layout and axes */
+
+/* Sizes in pixels that follow the font's scale (1, 2 or 3 by the frame's width). */
+typedef struct {
+  int scale, pad, bar_h, text_h, ch, tick;
+} metrics;
+
+static metrics metrics_for(unsigned width) {
+  int s = width >= 1200 ? 3 : width >= 600 ? 2 : 1;
+  metrics m = {s, 3 * s, 8 * s, 7 * s, 6 * s, 4 * s};
+  return m;
+}
+
+/* Ticks of one axis at k * step, k = k0 .. k0 + n - 1, labelled with `decimals`. */
+typedef struct {
+  double step;
+  long k0;
+  int n, decimals;
+} ticks;
+
+static void tick_label(char *buf, size_t len, const ticks *t, int i) {
+  double v = (double)(t->k0 + i) * t->step;
+  snprintf(buf, len, "%.*f", t->decimals, v);
+}
+
+/* Longest label of the ticks, in characters. */
+static int tick_chars(const ticks *t) {
+  int w = 0;
+  for (int i = 0; i < t->n; i++) {
+    char b[64];
+    tick_label(b, sizeof b, t, i);
+    int l = (int)strlen(b);
+    if (l > w)
+      w = l;
+  }
+  return w;
+}
+
+/* Round-number ticks (1, 2 or 5 times a power of ten) over [lo, hi], drawn on len pixels:
+ * the finest step whose ticks stand at least `gap` pixels apart (x axis: gap 0, the
+ * labels' width plus three characters). */
+static ticks axis_ticks(double lo, double hi, double len, const metrics *m, int gap) {
+  ticks t = {0, 0, 0, 0};
+  const double span = hi - lo;
+  if (!(span > 0) || !(len > 0))
+    return t;
+  double base = pow(10.0, floor(log10(span / 50.0)));
+  static const double mult[3] = {1, 2, 5};
+  for (int e = 0; e < 60; e++) {
+    double step = base * mult[e % 3] * pow(10.0, e / 3);
+    ticks c;
+    c.step = step;
+    c.k0 = (long)ceil(lo / step - 1e-9);
+    long k1 = (long)floor(hi / step + 1e-9);
+    c.n = k1 >= c.k0 ? (int)(k1 - c.k0 + 1) : 0;
+    double lg = floor(log10(step) + 1e-9);
+    c.decimals = lg < 0 ? (int)-lg : 0;
+    if (c.decimals > 12)
+      c.decimals = 12;
+    double need = gap ? gap : (tick_chars(&c) + 3) * m->ch;
+    if (c.n > 40)
+      continue;
+    t = c;
+    if (step / span * len >= need || c.n <= 2)
+      break;
+  }
+  return t;
+}
+
+/* The panel's layout: margins around the frame and the strips below it. */
+typedef struct {
+  metrics m;
+  unsigned fh, left, right, top, below, panel_h;
+  ticks tx, ty;
+} layout;
+
+static int make_layout(unsigned width, int panels, const double lo[2], const double hi[2],
+                       layout *L, rhod_picture_geometry *g) {
+  double ex = hi[0] - lo[0], ey = hi[1] - lo[1];
+  if (!(ex > 0) || !(ey > 0) || !isfinite(ex) || !isfinite(ey) || width < 1 || width > MAX_SIDE)
+    return -1;
+  double fhd = floor(width * ey / ex + 0.5);
+  if (!(fhd <= MAX_SIDE))
+    return -1;
+  L->fh = fhd < 1 ? 1u : (unsigned)fhd;
+  L->m = metrics_for(width);
+  const metrics *m = &L->m;
+  L->tx = axis_ticks(lo[0], hi[0], width, m, 0);
+  L->ty = axis_ticks(lo[1], hi[1], L->fh, m, 4 * m->text_h);
+  /* left: "y [m]" turned, the tick labels, the ticks; right: half the widest x label */
+  L->left =
+      (unsigned)(m->pad + m->text_h + 2 * m->pad + tick_chars(&L->ty) * m->ch + m->pad + m->tick);
+  int half = (tick_chars(&L->tx) * m->ch + 1) / 2;
+  L->right = (unsigned)(half > m->pad ? half : m->pad);
+  L->top = (unsigned)(m->text_h / 2 + m->pad);
+  /* below: ticks, their labels, "x [m]"; the colour bar, then two lines of text */
+  L->below = (unsigned)(m->tick + m->pad + m->text_h + m->pad + m->text_h + 2 * m->pad + m->bar_h +
+                        m->pad + m->text_h + m->pad + m->text_h + m->pad);
+  L->panel_h = L->top + L->fh + L->below;
+  const double pw = (double)L->left + width + L->right, ph = (double)panels * L->panel_h;
+  if (pw > MAX_SIDE || ph > MAX_SIDE)
+    return -1;
+  if (g) {
+    g->frame_x = L->left;
+    g->frame_y = L->top;
+    g->frame_w = width;
+    g->frame_h = L->fh;
+    g->panel_h = L->panel_h;
+    g->pic_w = (unsigned)pw;
+    g->pic_h = (unsigned)ph;
+    g->panels = (unsigned)panels;
+  }
+  return 0;
+}
+
+int rhod_picture_layout(unsigned width, int panels, const double lo[2], const double hi[2],
+                        rhod_picture_geometry *g) {
+  layout L;
+  if (panels < 1)
+    panels = 1;
+  return make_layout(width, panels, lo, hi, &L, g);
+}
+
+/* ------------------------------------------------------------ walls */
+
+static const unsigned char wall_ink[3] = {40, 40, 40};
+
+/* Clips the segment p0-p1 to [x0, x1] x [y0, y1] (Liang-Barsky); 0 when nothing is left. */
+static int clip(double p[2][2], double x0, double x1, double y0, double y1) {
+  double t0 = 0, t1 = 1, dx = p[1][0] - p[0][0], dy = p[1][1] - p[0][1];
+  const double q[4][2] = {
+      {-dx, p[0][0] - x0}, {dx, x1 - p[0][0]}, {-dy, p[0][1] - y0}, {dy, y1 - p[0][1]}};
+  for (int k = 0; k < 4; k++) {
+    double pk = q[k][0], qk = q[k][1];
+    if (pk == 0) {
+      if (qk < 0)
+        return 0;
+    } else {
+      double r = qk / pk;
+      if (pk < 0 && r > t0)
+        t0 = r;
+      if (pk > 0 && r < t1)
+        t1 = r;
+    }
+  }
+  if (t0 > t1)
+    return 0;
+  double a[2] = {p[0][0] + t0 * dx, p[0][1] + t0 * dy};
+  p[1][0] = p[0][0] + t1 * dx;
+  p[1][1] = p[0][1] + t1 * dy;
+  p[0][0] = a[0];
+  p[0][1] = a[1];
+  return 1;
+}
+
+/* A 2-pixel line along the segment (frame pixels, y down), kept inside the frame: a
+ * wall on the frame's edge shows as its two outermost pixel rows or columns. */
+static void thick_segment(canvas *f, unsigned fw, unsigned fh, double p[2][2]) {
+  const double tol = 1e-6 * (fw + fh);
+  if (!clip(p, -tol, fw + tol, -tol, fh + tol))
+    return;
+  for (int e = 0; e < 2; e++) {
+    p[e][0] = fmin(fmax(p[e][0], 1.0), fw > 1 ? fw - 1.0 : 1.0);
+    p[e][1] = fmin(fmax(p[e][1], 1.0), fh > 1 ? fh - 1.0 : 1.0);
+  }
+  double len = hypot(p[1][0] - p[0][0], p[1][1] - p[0][1]);
+  long steps = (long)ceil(2 * len) + 1;
+  for (long k = 0; k <= steps; k++) {
+    double t = (double)k / (double)steps;
+    double x = p[0][0] + t * (p[1][0] - p[0][0]), y = p[0][1] + t * (p[1][1] - p[0][1]);
+    long i = (long)floor(x - 0.5), j = (long)floor(y - 0.5);
+    for (long dj = 0; dj < 2; dj++)
+      for (long di = 0; di < 2; di++)
+        if (i + di >= 0 && i + di < (long)fw && j + dj >= 0 && j + dj < (long)fh)
+          put(f, i + di, j + dj, wall_ink);
+  }
+}
+
+static void draw_walls(canvas *f, unsigned fw, unsigned fh, const double lo[2], const double hi[2],
+                       const rhod_wall *walls, unsigned n_walls) {
+  const double sx = fw / (hi[0] - lo[0]), sy = fh / (hi[1] - lo[1]);
+  for (unsigned w = 0; w < n_walls; w++) {
+    const rhod_shape *sh = &walls[w].shape;
+    double rpx = sh->kind == RHOD_SHAPE_CIRCLE ? sh->radius * fmax(sx, sy) : 0;
+    double nc = ceil(6.283185307179586 * rpx / 2);
+    unsigned segs = nc < 32 ? 32u : nc > 4096 ? 4096u : (unsigned)nc;
+    unsigned n = rhod_shape_outline(sh, segs, NULL);
+    double(*pts)[2] = n ? malloc(sizeof(double[2]) * n) : NULL;
+    if (!pts)
+      continue; /* out of memory: the picture without this wall */
+    rhod_shape_outline(sh, segs, pts);
+    for (unsigned k = 0; k < n; k++) {
+      const double *a = pts[k], *b = pts[(k + 1) % n];
+      double p[2][2] = {{(a[0] - lo[0]) * sx, (hi[1] - a[1]) * sy},
+                        {(b[0] - lo[0]) * sx, (hi[1] - b[1]) * sy}};
+      if (isfinite(p[0][0]) && isfinite(p[0][1]) && isfinite(p[1][0]) && isfinite(p[1][1]))
+        thick_segment(f, fw, fh, p);
+    }
+    free(pts);
+  }
+}
+
+/* ------------------------------------------------------------ panels */
+
+/* The axes around the frame at (x0, y0) of fw x fh: a grey border, ticks and their labels
+ * along the left and bottom edges, "x [m]" below and "y [m]" turned at the left. */
+static void draw_axes(canvas *c, const layout *L, long x0, long y0, unsigned fw, const double lo[2],
+                      const double hi[2]) {
+  static const unsigned char border[3] = {160, 160, 160}, ink[3] = {0, 0, 0};
+  const metrics *m = &L->m;
+  const long fh = L->fh;
+  for (long i = x0 - 1; i <= x0 + (long)fw; i++) {
+    put(c, i, y0 - 1, border);
+    put(c, i, y0 + fh, border);
+  }
+  for (long j = y0 - 1; j <= y0 + fh; j++) {
+    put(c, x0 - 1, j, border);
+    put(c, x0 + (long)fw, j, border);
+  }
+  char b[64];
+  const double sx = fw / (hi[0] - lo[0]), sy = fh / (hi[1] - lo[1]);
+  for (int k = 0; k < L->tx.n; k++) {
+    double v = (double)(L->tx.k0 + k) * L->tx.step;
+    long px = x0 + (long)floor((v - lo[0]) * sx);
+    if (px >= x0 + (long)fw)
+      px = x0 + (long)fw - 1;
+    for (long j = y0 + fh + 1; j < y0 + fh + 1 + m->tick; j++)
+      for (int d = 0; d < m->scale; d++)
+        put(c, px + d - m->scale / 2, j, ink);
+    tick_label(b, sizeof b, &L->tx, k);
+    draw_text(c, px - text_width(b, m->scale) / 2, y0 + fh + 1 + m->tick + m->pad, m->scale, b);
+  }
+  const char *xt = "x [m]", *yt = "y [m]";
+  draw_text(c, x0 + ((long)fw - text_width(xt, m->scale)) / 2,
+            y0 + fh + 1 + m->tick + 2 * m->pad + m->text_h, m->scale, xt);
+  for (int k = 0; k < L->ty.n; k++) {
+    double v = (double)(L->ty.k0 + k) * L->ty.step;
+    long py = y0 + (long)floor((hi[1] - v) * sy);
+    if (py >= y0 + fh)
+      py = y0 + fh - 1;
+    for (long i = x0 - 1 - m->tick; i < x0 - 1; i++)
+      for (int d = 0; d < m->scale; d++)
+        put(c, i, py + d - m->scale / 2, ink);
+    tick_label(b, sizeof b, &L->ty, k);
+    draw_text(c, x0 - 1 - m->tick - m->pad - text_width(b, m->scale), py - m->text_h / 2, m->scale,
+              b);
+  }
+  draw_text_up(c, m->pad, y0 + (fh + text_width(yt, m->scale)) / 2, m->scale, yt);
+}
+
+/* One panel at rows [y_off, y_off + panel_h): the particles coloured by `field` in the
+ * frame [lo, hi], the walls, the axes, the colour bar with "min  label  max" and the
+ * time (with the label when they do not fit on one line). -1: out of memory. */
+static int draw_panel(canvas *c, long y_off, const layout *L, unsigned width,
+                      const rhod_snapshot_view *v, rhod_field field, const double lo[2],
+                      const double hi[2], const double *range, const rhod_wall *walls,
+                      unsigned n_walls) {
+  const metrics *m = &L->m;
+  const unsigned fh = L->fh;
   double vmin = 0, vmax = 0;
   if (range) {
     vmin = range[0];
     vmax = range[1];
   } else {
-    int any = 0;
-    for (size_t i = 0; i < v->n; i++) {
-      double f = field_value(v, field, i);
-      if (!isfinite(f))
-        continue;
-      if (!any || f < vmin)
-        vmin = f;
-      if (!any || f > vmax)
-        vmax = f;
-      any = 1;
-    }
+    double r[2];
+    rhod_picture_field_range(v, field, r);
+    vmin = r[0];
+    vmax = r[1];
   }
-  /* the frame, drawn into a view of the canvas that starts at row y_off */
-  canvas f = {c->px + 3 * (size_t)y_off * width, width, c->h - (unsigned)y_off};
+  /* the frame: a view of the canvas with its own origin, clipped to the frame */
+  const long x0 = L->left, y0 = y_off + L->top;
+  /* drawn into a frame-sized buffer, then copied in (the canvas rows are wider) */
+  unsigned char *rows = malloc((size_t)3 * width * fh);
+  if (!rows)
+    return -1;
+  memset(rows, 255, (size_t)3 * width * fh);
+  canvas f = {rows, width, fh};
   const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], sx = width / ex, sy = fh / ey;
   static const unsigned char grey[3] = {160, 160, 160};
   for (size_t i = 0; i < v->n; i++) {
@@ -258,42 +561,53 @@ static void draw_panel(canvas *c, long y_off, unsigned fh, int scale, const rhod
       colour_at(scale_at(field, val, vmin, vmax), rgb);
     disc(&f, fh, cx, cy, r, rgb);
   }
+  draw_walls(&f, width, fh, lo, hi, walls, n_walls);
+  for (unsigned j = 0; j < fh; j++)
+    memcpy(c->px + 3 * ((size_t)(y0 + j) * c->w + (size_t)x0), rows + (size_t)3 * width * j,
+           (size_t)3 * width);
+  free(rows);
+  draw_axes(c, L, x0, y0, width, lo, hi);
 
-  /* The strip: a rule, the colour bar, then "min   field  t=...s   max". */
-  int pad = 3 * scale, bar_h = 8 * scale;
-  static const unsigned char rule[3] = {200, 200, 200};
-  for (unsigned i = 0; i < width; i++)
-    put(&f, i, fh, rule);
-  long y0 = (long)fh + 1 + pad, x0 = pad, x1 = (long)width - pad;
-  if (x1 <= x0) {
-    x0 = 0;
-    x1 = width;
-  }
-  for (long i = x0; i < x1; i++) {
+  /* the colour bar under the frame's columns, then its text */
+  long by = y0 + fh + 1 + m->tick + m->pad + m->text_h + m->pad + m->text_h + 2 * m->pad;
+  long bx0 = x0, bx1 = x0 + (long)width;
+  for (long i = bx0; i < bx1; i++) {
     unsigned char rgb[3];
-    colour_at(x1 - x0 > 1 ? (double)(i - x0) / (double)(x1 - x0 - 1) : 0.0, rgb);
-    for (long j = y0; j < y0 + bar_h; j++)
-      put(&f, i, j, rgb);
+    colour_at(bx1 - bx0 > 1 ? (double)(i - bx0) / (double)(bx1 - bx0 - 1) : 0.0, rgb);
+    for (long j = by; j < by + m->bar_h; j++)
+      put(c, i, j, rgb);
   }
-  long ty = y0 + bar_h + pad;
-  char smin[32], smax[32], mid[64];
+  long ty = by + m->bar_h + m->pad;
+  char smin[32], smax[32], label[64], tline[192];
   fmt_value(smin, sizeof smin, vmin);
   fmt_value(smax, sizeof smax, vmax);
-  snprintf(mid, sizeof mid, "%s%s  t=%.6gs", field_label(field),
-           field == RHOD_FIELD_SIZE && vmin > 0 ? " (log)" : "", v->time);
-  long wmin = text_width(smin, scale), wmax = text_width(smax, scale);
-  long wmid = text_width(mid, scale);
-  draw_text(&f, x0, ty, scale, smin);
-  if (x1 - wmax > x0 + wmin + 2 * scale)
-    draw_text(&f, x1 - wmax, ty, scale, smax);
-  long mx = ((long)width - wmid) / 2;
-  if (mx > x0 + wmin + 2 * scale && mx + wmid + 2 * scale < x1 - wmax)
-    draw_text(&f, mx, ty, scale, mid);
+  snprintf(label, sizeof label, "%s%s", field_label(field),
+           field == RHOD_FIELD_SIZE && vmin > 0 ? " (log)" : "");
+  snprintf(tline, sizeof tline, "t = %.6g s", v->time);
+  const int sc = m->scale;
+  long wmin = text_width(smin, sc), wmax = text_width(smax, sc), wl = text_width(label, sc);
+  draw_text(c, bx0, ty, sc, smin);
+  if (bx1 - wmax > bx0 + wmin + 2 * sc)
+    draw_text(c, bx1 - wmax, ty, sc, smax);
+  long mx = x0 + ((long)width - wl) / 2;
+  if (mx > bx0 + wmin + 2 * sc && mx + wl + 2 * sc < bx1 - wmax) {
+    draw_text(c, mx, ty, sc, label);
+  } else {
+    char both[160];
+    snprintf(both, sizeof both, "%.60s  %.96s", label, tline);
+    snprintf(tline, sizeof tline, "%.180s", both);
+  }
+  long wt = text_width(tline, sc), tx = x0 + ((long)width - wt) / 2;
+  if (tx < 0)
+    tx = 0;
+  draw_text(c, tx, ty + m->text_h + m->pad, sc, tline);
+  return 0;
 }
 
 int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
                        int size_panel, unsigned width, const double lo[2], const double hi[2],
-                       const double *range, char *err, size_t errlen) {
+                       const double *range, const rhod_wall *walls, unsigned n_walls, char *err,
+                       size_t errlen) {
   double ex = hi[0] - lo[0], ey = hi[1] - lo[1];
   if (!(ex > 0) || !(ey > 0) || !isfinite(ex) || !isfinite(ey)) {
     if (err && errlen)
@@ -301,12 +615,15 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
                lo[0], hi[0], lo[1], hi[1]);
     return RHOD_ERR_SCENE;
   }
-  const unsigned panels = size_panel && field != RHOD_FIELD_SIZE ? 2 : 1;
-  double fhd = floor(width * ey / ex + 0.5);
-  if (width < 1 || width > MAX_SIDE || !(fhd * panels <= MAX_SIDE)) {
+  const int panels = size_panel && field != RHOD_FIELD_SIZE ? 2 : 1;
+  layout L;
+  rhod_picture_geometry g;
+  if (make_layout(width, panels, lo, hi, &L, &g) != 0) {
     if (err && errlen)
-      snprintf(err, errlen, "%s: cannot draw: picture size %u x %.0f outside 1..%u", path, width,
-               fhd * panels, MAX_SIDE);
+      snprintf(err, errlen,
+               "%s: cannot draw: picture of a %u pixel wide frame of [%g, %g] x "
+               "[%g, %g] outside 1..%u pixels",
+               path, width, lo[0], hi[0], lo[1], hi[1], MAX_SIDE);
     return RHOD_ERR_SCENE;
   }
   if ((int)field < RHOD_FIELD_PRESSURE || (int)field > RHOD_FIELD_FREE_SURFACE) {
@@ -319,15 +636,13 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
       snprintf(err, errlen, "%s: cannot draw: a particle field is missing", path);
     return RHOD_ERR_IO;
   }
-  unsigned fh = fhd < 1 ? 1u : (unsigned)fhd;
+  if (!walls)
+    n_walls = 0;
 
-  /* Layout: per panel, frame rows [0, fh), a grey rule, then the strip; with the size
-   * panel (paper 002 Figs. 11, 17, 19 show the sizes beside the fields) the same frame
-   * coloured by size below the field's. */
-  int scale = width >= 1200 ? 3 : width >= 600 ? 2 : 1;
-  int pad = 3 * scale, bar_h = 8 * scale, text_h = 7 * scale;
-  unsigned strip = (unsigned)(1 + pad + bar_h + pad + text_h + pad);
-  canvas c = {NULL, width, panels * (fh + strip)};
+  /* Layout (make_layout): per panel, a top margin, the frame with the axes at its left
+   * and bottom, the colour bar strip; with the size panel (paper 002 Figs. 11, 17, 19
+   * show the sizes beside the fields) the same frame coloured by size below. */
+  canvas c = {NULL, g.pic_w, g.pic_h};
   size_t bytes = (size_t)3 * c.w * c.h;
   c.px = malloc(bytes);
   if (!c.px) {
@@ -336,9 +651,16 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
     return RHOD_ERR_MEMORY;
   }
   memset(c.px, 255, bytes);
-  draw_panel(&c, 0, fh, scale, v, field, lo, hi, range);
-  if (panels == 2)
-    draw_panel(&c, (long)(fh + strip), fh, scale, v, RHOD_FIELD_SIZE, lo, hi, NULL);
+  int oom = draw_panel(&c, 0, &L, width, v, field, lo, hi, range, walls, n_walls) != 0;
+  if (panels == 2 && !oom)
+    oom = draw_panel(&c, (long)L.panel_h, &L, width, v, RHOD_FIELD_SIZE, lo, hi, NULL, walls,
+                     n_walls) != 0;
+  if (oom) {
+    free(c.px);
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot draw: out of memory", path);
+    return RHOD_ERR_MEMORY;
+  }
 
   /* Encode into memory, then write atomically. */
   png_image img;

@@ -1441,19 +1441,21 @@ double rhod_scene_particle_estimate(const rhod_scene *s) {
  * "load-time limits"): the picture's size, the snapshot and probe-row counts, the steps
  * time.end needs, the initial particle count. */
 static int check_limits(lctx *c, rhod_scene *s) {
-  /* the picture: src/picture.c draws at most RHOD_PICTURE_MAX_SIDE pixels a side */
+  /* the picture: laid out as src/picture.c lays it out (frame, axes, colour bar), at
+   * most RHOD_PICTURE_MAX_SIDE pixels a side */
   if (s->picture_enabled) {
     const double *lo = s->picture_box_set ? s->picture_box_min : s->domain_min;
     const double *hi = s->picture_box_set ? s->picture_box_max : s->domain_max;
     const double ex = hi[0] - lo[0], ey = hi[1] - lo[1];
-    const unsigned panels = s->picture_size_panel ? 2 : 1;
-    const double h = floor(s->picture_width * ey / ex + 0.5) * panels;
-    if (!(h <= RHOD_PICTURE_MAX_SIDE))
+    const int panels = s->picture_size_panel && s->picture_field != RHOD_FIELD_SIZE ? 2 : 1;
+    rhod_picture_geometry g;
+    if (rhod_picture_layout(s->picture_width, panels, lo, hi, &g) != 0)
       return fail(c, "output.picture.width",
-                  "%u pixels wide makes the picture %.0f pixels high (the %s is %g m x %g m%s), "
-                  "more than %u: lower the width or draw a smaller output.picture.box",
-                  s->picture_width, h, s->picture_box_set ? "box" : "domain", ex, ey,
-                  panels == 2 ? ", two panels" : "", RHOD_PICTURE_MAX_SIDE);
+                  "%u pixels wide makes the picture about %.0f pixels high (the %s is %g m x %g "
+                  "m%s), more than %u: lower the width or draw a smaller output.picture.box",
+                  s->picture_width, floor(s->picture_width * ey / ex + 0.5) * panels,
+                  s->picture_box_set ? "box" : "domain", ex, ey, panels == 2 ? ", two panels" : "",
+                  RHOD_PICTURE_MAX_SIDE);
   }
   /* time: every step is at most Eq. 11's acoustic bound at the coarsest size */
   const double dt_max = s->cfl * s->radius_ratio * s->dx / s->c0;

@@ -388,7 +388,7 @@ static void test_xdmf(void) {
   double times[3] = {0.0, 0.25, 1.5};
   size_t np[3] = {10, 10, 9};
   char err[512] = "";
-  CU_ASSERT_EQUAL_FATAL(rhod_write_xdmf(scratch, 3, times, np, err, sizeof err), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_write_xdmf(scratch, 3, times, np, 0, err, sizeof err), RHOD_OK);
   const char *path = spath("snapshots.xdmf");
   CU_ASSERT(!exists(spath("snapshots.xdmf.tmp")));
   char *s = slurp(path, NULL);
@@ -422,7 +422,7 @@ static void test_xdmf(void) {
   free(s);
 
   /* rewritten after each snapshot: one more grid */
-  CU_ASSERT_EQUAL(rhod_write_xdmf(scratch, 2, times, np, err, sizeof err), RHOD_OK);
+  CU_ASSERT_EQUAL(rhod_write_xdmf(scratch, 2, times, np, 0, err, sizeof err), RHOD_OK);
   s = slurp(path, NULL);
   CU_ASSERT_PTR_NOT_NULL_FATAL(s);
   CU_ASSERT_EQUAL(count_of(s, "<Grid "), 3);
@@ -431,7 +431,7 @@ static void test_xdmf(void) {
 
   char dir[4200];
   snprintf(dir, sizeof dir, "%s/no_such_dir", scratch);
-  CU_ASSERT_EQUAL(rhod_write_xdmf(dir, 3, times, np, err, sizeof err), RHOD_ERR_IO);
+  CU_ASSERT_EQUAL(rhod_write_xdmf(dir, 3, times, np, 0, err, sizeof err), RHOD_ERR_IO);
   CU_ASSERT_PTR_NOT_NULL(strstr(err, "no_such_dir/snapshots.xdmf: cannot write"));
 }
 
@@ -480,10 +480,16 @@ static void test_picture(void) {
   rhod_snapshot_view v = view_of(&P, 0.125);
   double lo[2] = {0, 0}, hi[2] = {2, 1};
   char err[512] = "";
+  /* where the frames are (the axes take a margin around them) */
+  rhod_picture_geometry g, g1;
+  CU_ASSERT_EQUAL_FATAL(rhod_picture_layout(200, 1, lo, hi, &g), 0);
+  CU_ASSERT_EQUAL(g.frame_w, 200);
+  CU_ASSERT_EQUAL(g.frame_h, 100);
+  CU_ASSERT_EQUAL_FATAL(rhod_picture_layout(100, 1, lo, hi, &g1), 0);
   const char *path = spath("pressure.png");
-  CU_ASSERT_EQUAL_FATAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, NULL, err, sizeof err),
-      RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, NULL,
+                                           NULL, 0, err, sizeof err),
+                        RHOD_OK);
   CU_ASSERT(!exists(spath("pressure.png.tmp")));
   size_t len = 0;
   char *raw = slurp(path, &len);
@@ -493,32 +499,33 @@ static void test_picture(void) {
 
   rgb_image im = {0, 0, NULL};
   CU_ASSERT_FATAL(read_png(path, &im));
-  CU_ASSERT_EQUAL(im.w, 200);
-  CU_ASSERT(im.h > 100); /* frame plus the colour bar strip */
+  CU_ASSERT_EQUAL(im.w, g.pic_w);
+  CU_ASSERT_EQUAL(im.h, g.pic_h); /* frame plus the axes and the colour bar strip */
   /* auto range [0, 10]: particle 0 (p = 10) at pixel (50, 50) is the top colour of
    * viridis, particle 1 (p = 0) at (150, 50) the bottom one; y is up. */
-  CU_ASSERT(pixel_is(&im, 50, 50, 253, 231, 37));
-  CU_ASSERT(pixel_is(&im, 59, 50, 253, 231, 37)); /* disc of radius 10 px */
-  CU_ASSERT(pixel_is(&im, 150, 50, 68, 1, 84));
-  CU_ASSERT(pixel_is(&im, 100, 10, 33, 144, 140));  /* p = 5: the middle stop, y = 0.9 */
-  CU_ASSERT(pixel_is(&im, 100, 90, 255, 255, 255)); /* background */
-  CU_ASSERT(pixel_is(&im, 50, 62, 255, 255, 255));  /* outside the disc */
+  CU_ASSERT(pixel_is(&im, g.frame_x + 50, g.frame_y + 50, 253, 231, 37));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 59, g.frame_y + 50, 253, 231, 37)); /* disc of radius 10 px */
+  CU_ASSERT(pixel_is(&im, g.frame_x + 150, g.frame_y + 50, 68, 1, 84));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 100, g.frame_y + 10, 33, 144,
+                     140)); /* p = 5: the middle stop, y = 0.9 */
+  CU_ASSERT(pixel_is(&im, g.frame_x + 100, g.frame_y + 90, 255, 255, 255)); /* background */
+  CU_ASSERT(pixel_is(&im, g.frame_x + 50, g.frame_y + 62, 255, 255, 255));  /* outside the disc */
   /* a tiny particle (0.1 px) still covers its pixel: p = 2 -> t = 0.2, 60 % of the way
    * from the second stop (71, 45, 123) to the third (59, 82, 139) */
-  CU_ASSERT(pixel_is(&im, 190, 90, 64, 67, 133));
-  CU_ASSERT(pixel_is(&im, 191, 90, 255, 255, 255));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 190, g.frame_y + 90, 64, 67, 133));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 191, g.frame_y + 90, 255, 255, 255));
   /* the colour bar spans the strip: dark at the left, yellow at the right */
   int found_lo = 0, found_hi = 0;
-  for (unsigned y = 100; y < im.h; y++)
-    for (unsigned x = 0; x < 20; x++) {
+  for (unsigned y = g.frame_y + 100; y < im.h; y++)
+    for (unsigned x = g.frame_x; x < g.frame_x + 20; x++) {
       found_lo |= pixel_is(&im, x, y, 68, 1, 84);
-      found_hi |= pixel_is(&im, im.w - 1 - x, y, 253, 231, 37);
+      found_hi |= pixel_is(&im, g.frame_x + 199 - (x - g.frame_x), y, 253, 231, 37);
     }
   CU_ASSERT(found_lo);
   CU_ASSERT(found_hi);
   /* text in black somewhere in the strip */
   int ink = 0;
-  for (unsigned y = 100; y < im.h; y++)
+  for (unsigned y = g.frame_y + 100; y < im.h; y++)
     for (unsigned x = 0; x < im.w; x++)
       ink |= pixel_is(&im, x, y, 0, 0, 0);
   CU_ASSERT(ink);
@@ -526,11 +533,11 @@ static void test_picture(void) {
 
   /* a given range: p = 10 in [0, 20] is the middle stop */
   double range[2] = {0, 20};
-  CU_ASSERT_EQUAL_FATAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, range, err, sizeof err),
-      RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, range,
+                                           NULL, 0, err, sizeof err),
+                        RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
-  CU_ASSERT(pixel_is(&im, 50, 50, 33, 144, 140));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 50, g.frame_y + 50, 33, 144, 140));
   free(im.px);
 
   /* velocity magnitude and free surface; fs NULL means every particle is inner */
@@ -539,20 +546,20 @@ static void test_picture(void) {
   P.ux[1] = 0;
   P.uy[1] = 0;
   double r2[2] = {0, 5};
-  CU_ASSERT_EQUAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_VELOCITY, 0, 200, lo, hi, r2, err, sizeof err),
-      RHOD_OK);
+  CU_ASSERT_EQUAL(rhod_write_picture(path, &v, RHOD_FIELD_VELOCITY, 0, 200, lo, hi, r2, NULL, 0,
+                                     err, sizeof err),
+                  RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
-  CU_ASSERT(pixel_is(&im, 50, 50, 253, 231, 37));
-  CU_ASSERT(pixel_is(&im, 150, 50, 68, 1, 84));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 50, g.frame_y + 50, 253, 231, 37));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 150, g.frame_y + 50, 68, 1, 84));
   free(im.px);
   v.fs = NULL;
-  CU_ASSERT_EQUAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 0, 100, lo, hi, NULL, err, sizeof err),
-      RHOD_OK);
+  CU_ASSERT_EQUAL(rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 0, 100, lo, hi, NULL, NULL,
+                                     0, err, sizeof err),
+                  RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
-  CU_ASSERT_EQUAL(im.w, 100);
-  CU_ASSERT(pixel_is(&im, 25, 25, 68, 1, 84));
+  CU_ASSERT_EQUAL(im.w, g1.pic_w);
+  CU_ASSERT(pixel_is(&im, g1.frame_x + 25, g1.frame_y + 25, 68, 1, 84));
   free(im.px);
 
   /* the size panel: the same frame below, coloured by size on a log scale over
@@ -560,40 +567,40 @@ static void test_picture(void) {
    * particle 2 (0.1) at log(100)/log(200) = 0.869 of the scale (between the stops
    * (93, 200, 99) and (170, 220, 50)); the field's panel above unchanged */
   const unsigned h1 = im.h;
-  CU_ASSERT_EQUAL_FATAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 1, 100, lo, hi, NULL, err, sizeof err),
-      RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 1, 100, lo, hi, NULL,
+                                           NULL, 0, err, sizeof err),
+                        RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
   CU_ASSERT_EQUAL(im.h, 2 * h1);
-  CU_ASSERT(pixel_is(&im, 25, 25, 68, 1, 84));
-  CU_ASSERT(pixel_is(&im, 25, h1 + 25, 253, 231, 37));
-  CU_ASSERT(pixel_is(&im, 95, h1 + 45, 68, 1, 84));
+  CU_ASSERT(pixel_is(&im, g1.frame_x + 25, g1.frame_y + 25, 68, 1, 84));
+  CU_ASSERT(pixel_is(&im, g1.frame_x + 25, g1.panel_h + g1.frame_y + 25, 253, 231, 37));
+  CU_ASSERT(pixel_is(&im, g1.frame_x + 95, g1.panel_h + g1.frame_y + 45, 68, 1, 84));
   {
     const double t = log(100.0) / log(200.0) * 8 - 6;
     const int r = (int)lround(93 + t * (170 - 93)), g = (int)lround(200 + t * (220 - 200)),
               b = (int)lround(99 + t * (50 - 99));
-    CU_ASSERT(pixel_is(&im, 50, h1 + 5, r, g, b));
+    CU_ASSERT(pixel_is(&im, g1.frame_x + 50, g1.panel_h + g1.frame_y + 5, r, g, b));
   }
   free(im.px);
   /* no second panel when the field is the size itself */
   CU_ASSERT_EQUAL_FATAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_SIZE, 1, 100, lo, hi, NULL, err, sizeof err),
+      rhod_write_picture(path, &v, RHOD_FIELD_SIZE, 1, 100, lo, hi, NULL, NULL, 0, err, sizeof err),
       RHOD_OK);
   CU_ASSERT_FATAL(read_png(path, &im));
   CU_ASSERT_EQUAL(im.h, h1);
-  CU_ASSERT(pixel_is(&im, 25, 25, 253, 231, 37));
+  CU_ASSERT(pixel_is(&im, g1.frame_x + 25, g1.frame_y + 25, 253, 231, 37));
   free(im.px);
 
   /* errors: an empty frame; a folder that does not exist (nothing left behind) */
   double bad_hi[2] = {0, 1};
-  CU_ASSERT_EQUAL(
-      rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, bad_hi, NULL, err, sizeof err),
-      RHOD_ERR_SCENE);
+  CU_ASSERT_EQUAL(rhod_write_picture(path, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, bad_hi, NULL, NULL,
+                                     0, err, sizeof err),
+                  RHOD_ERR_SCENE);
   CU_ASSERT_PTR_NOT_NULL(strstr(err, path));
   const char *nodir = spath("no_such_dir/p.png");
-  CU_ASSERT_EQUAL(
-      rhod_write_picture(nodir, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, NULL, err, sizeof err),
-      RHOD_ERR_IO);
+  CU_ASSERT_EQUAL(rhod_write_picture(nodir, &v, RHOD_FIELD_PRESSURE, 0, 200, lo, hi, NULL, NULL, 0,
+                                     err, sizeof err),
+                  RHOD_ERR_IO);
   CU_ASSERT_PTR_NOT_NULL(strstr(err, nodir));
   free_particles(&P);
 }
@@ -621,7 +628,7 @@ static void test_picture_speed(void) {
   char err[512];
   double t0 = now();
   int rc = rhod_write_picture(spath("speed.png"), &v, RHOD_FIELD_PRESSURE, 0, 800, lo, hi, NULL,
-                              err, sizeof err);
+                              NULL, 0, err, sizeof err);
   double dt = now() - t0;
   CU_ASSERT_EQUAL(rc, RHOD_OK);
   printf("\n    picture of 1e5 particles at 800 px: %.1f ms ", 1e3 * dt);

@@ -44,9 +44,14 @@ def parameters(out):
     snaps = snapshots(out)
     if not snaps:
         raise SystemExit(f"{out}: no snapshot_*.h5")
+    def text(v):
+        return v.decode() if isinstance(v, bytes) else str(v)
     with h5py.File(snaps[0], "r") as f:
-        return {k: (v.decode() if isinstance(v, bytes) else str(v))
-                for k, v in f["Parameters"].attrs.items()}
+        g = f["Parameters"]
+        if "Keys" in g and "Values" in g:  # any number of keys, in scene order
+            return {text(k): text(v) for k, v in zip(g["Keys"][()], g["Values"][()])}
+        # older snapshots: one attribute per key
+        return {k: text(v) for k, v in g.attrs.items()}
 
 
 def number(params, key):

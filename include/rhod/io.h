@@ -31,9 +31,15 @@ int rhod_snapshot_check(const rhod_snapshot_view *v, char *err, size_t errlen);
 
 /* OUT/snapshot_NNNN.h5: /Header attrs Time, Dimension (2), NumPart; /PartType0 datasets
  * Coordinates, Velocities (N x 3, z = 0), Densities, Pressures, Masses, ParticleSizes,
- * ParticleIDs, FreeSurface (if fs); /Parameters string attributes (dotted keys). Plain
- * contiguous datasets, no filters. Stored as double whatever the build precision.
- * /Header also carries the strings Code ("rhod") and Precision (RHOD_REAL_NAME).
+ * ParticleIDs, FreeSurface (if fs); /Mesh/Vertices (N x 1, 0..N-1: the XDMF vertex
+ * cells); /Parameters/Keys and /Parameters/Values (variable-length strings, the dotted
+ * keys in scene order, any number) and, up to 65535 keys, one string attribute per key
+ * on /Parameters (dense storage, creation order tracked). Plain contiguous datasets, no filters.
+ * Stored as double whatever the build precision. Every dataset has a string attribute Units:
+ * Coordinates "m", Velocities "m/s", Densities "kg/m^3", Pressures "Pa", Masses "kg/m" (2D: per
+ * unit depth), ParticleSizes "m", ParticleIDs, FreeSurface and Vertices "1", Keys and Values ""
+ * (text). /Header also carries the strings Code ("rhod"), Precision (RHOD_REAL_NAME), CodeVersion
+ * (rhod_version()) and GitCommit (rhod_commit()).
  * The file is built in memory, then written through rhod_write_bytes_atomic.
  * Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"), RHOD_ERR_MEMORY. */
 int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
@@ -48,7 +54,8 @@ typedef struct {
   double *x, *y, *ux, *uy, *rho, *p, *m, *size;
   uint64_t *id;
   uint8_t *fs;            /* FreeSurface, NULL when the file has none */
-  rhod_param_list params; /* /Parameters in file order; owned here, freed by
+  rhod_param_list params; /* /Parameters (Keys and Values; in older files the attributes)
+                             in file order; owned here, freed by
                              rhod_snapshot_data_free (not rhod_param_list_free) */
 } rhod_snapshot_data;
 int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen);
@@ -58,23 +65,65 @@ void rhod_snapshot_data_free(rhod_snapshot_data *d);
 int rhod_read_snapshot_header(const char *path, double *time, uint64_t *n, char *err,
                               size_t errlen);
 
+/* Which optional datasets a snapshot of this view holds (bits below). */
+#define RHOD_FIELDS_FREE_SURFACE 1u
+unsigned rhod_snapshot_fields(const rhod_snapshot_view *v);
+
 /* OUT/snapshots.xdmf: a temporal collection of every snapshot written so far, as a
- * Polyvertex grid that ParaView opens as a time series. Rewritten (atomically) after
- * each snapshot. XDMF 2 like SWIFT's .xmf: ParaView's "XDMF Reader" makes one vertex
- * cell per particle; its Xdmf3 readers give the points (Point Gaussian view) and fields. */
+ * Polyvertex grid (XDMF 3) with explicit connectivity (/Mesh/Vertices), so that ParaView's
+ * XDMF readers and meshio's XdmfTimeSeriesReader get one vertex cell per particle, and
+ * every field of the snapshot as a node attribute: Velocity, Density, Pressure, Mass,
+ * ParticleSize, ParticleID and, when `fields` has RHOD_FIELDS_FREE_SURFACE (every
+ * snapshot of a run has the same datasets), FreeSurface. Rewritten (atomically) after
+ * each snapshot. */
 int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
-                    char *err, size_t errlen);
+                    unsigned fields, char *err, size_t errlen);
+
+/* The closed outline of a shape as a polygon: a rect's 4 corners, a polygon's points,
+ * a circle as `circle_segments` points (at least 8). out (may be NULL: count only) holds
+ * at least the returned count of points. */
+unsigned rhod_shape_outline(const rhod_shape *sh, unsigned circle_segments, double (*out)[2]);
+
+/* OUT/walls.h5 and OUT/walls.xdmf: the walls of the scene (each wall's boundary as a
+ * closed polyline; circles with segments no longer than dx/4) as line segments that
+ * ParaView opens beside the particles, written once per run. walls.h5: /Header attrs
+ * NumWalls, CodeVersion, GitCommit; /Walls/Points (P x 3, z = 0, "m"), /Walls/Segments
+ * (S x 2 point indices), /Walls/WallIndex (S: the wall's index in the scene's `walls`),
+ * /Walls/FluidInside (one per wall: 1 container, 0 obstacle). walls.xdmf: one Uniform
+ * grid, Topology Polyline (2 nodes per element), cell attribute WallIndex. A scene
+ * without walls writes neither (and removes old ones). Both written atomically.
+ * Errors: RHOD_ERR_IO, RHOD_ERR_MEMORY. */
+int rhod_write_walls(const char *dir, const rhod_scene *sc, char *err, size_t errlen);
 
 /* A PNG picture of one field: each particle a disc of its own size, coloured by a
- * perceptual colour map (particle size: on a log scale); the frame is the box [lo, hi];
- * a colour bar with its range and the time are drawn. range NULL: auto (min/max of the
- * field). The picture is width pixels wide; below the frame is a strip with the bar and
- * labels. size_panel (ignored when the field is the size): a second panel below, the
- * same frame coloured by particle size. Errors: RHOD_ERR_SCENE (empty frame, width or
- * height outside 1..16384), RHOD_ERR_IO (cannot write). */
+ * perceptual colour map (particle size: on a log scale); the frame is the box [lo, hi],
+ * `width` pixels wide (its height keeps the aspect ratio); the walls (n_walls of them,
+ * may be NULL when 0) drawn as dark 2-pixel lines inside the frame; axes with tick labels
+ * in metres along the frame's left and bottom edges ("x [m]", "y [m]"); below, a colour
+ * bar with its range, the field's name and unit (e.g. "p [Pa]") and the time. range
+ * NULL: automatic (rhod_picture_field_range). size_panel (ignored when the field is the
+ * size): a second panel below, the same frame coloured by particle size.
+ * rhod_picture_layout says where the frames are. Errors: RHOD_ERR_SCENE (empty frame,
+ * picture side outside 1..16384), RHOD_ERR_IO (cannot write). */
 int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
                        int size_panel, unsigned width, const double lo[2], const double hi[2],
-                       const double *range, char *err, size_t errlen);
+                       const double *range, const rhod_wall *walls, unsigned n_walls, char *err,
+                       size_t errlen);
+
+/* The colour range a picture of `field` uses when given none: the smallest and largest
+ * finite value over the particles (the size field: of the sizes, drawn on a log scale).
+ * Returns 0, or -1 when no particle has a finite value (range set to [0, 0]). */
+int rhod_picture_field_range(const rhod_snapshot_view *v, rhod_field f, double range[2]);
+
+/* Where rhod_write_picture puts things, in pixels from the top-left corner: the first
+ * panel's frame at (frame_x, frame_y), frame_w x frame_h (frame_w = width); the next
+ * panel's frame panel_h rows lower; the picture is pic_w x pic_h. Returns 0, or -1 for
+ * an empty frame or a side outside 1..16384. */
+typedef struct {
+  unsigned frame_x, frame_y, frame_w, frame_h, panel_h, pic_w, pic_h, panels;
+} rhod_picture_geometry;
+int rhod_picture_layout(unsigned width, int panels, const double lo[2], const double hi[2],
+                        rhod_picture_geometry *g);
 
 /* probes.csv: a header row (first column t) then one row per sample. The file is kept
  * open and flushed after every row. */
