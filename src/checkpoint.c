@@ -324,13 +324,18 @@ int rhod_checkpoint_read(const char *path, rhod_checkpoint *ck, char *err, size_
   memset(ck, 0, sizeof *ck);
   char *b = NULL;
   size_t len = 0;
-  const int e = rhod_read_file(path, &b, &len);
+  const size_t max =
+      RHOD_CHECKPOINT_MAX_BYTES < SIZE_MAX / 2 ? (size_t)RHOD_CHECKPOINT_MAX_BYTES : SIZE_MAX / 2;
+  const int e = rhod_read_file(path, max, &b, &len);
   if (e == ENOMEM) {
     snprintf(err, errlen, "%s: out of memory", path);
     return RHOD_ERR_MEMORY;
   }
+  if (e == RHOD_READ_TOO_LARGE)
+    return read_fail(err, errlen, path, "cannot read the checkpoint: larger than %llu GiB",
+                     (unsigned long long)(max >> 30));
   if (e)
-    return read_fail(err, errlen, path, "cannot read the checkpoint: %s", strerror(e));
+    return read_fail(err, errlen, path, "cannot read the checkpoint: %s", rhod_read_strerror(e));
   int rc = rhod_checkpoint_parse(b, len, path, ck, err, errlen);
   free(b);
   return rc;

@@ -97,35 +97,64 @@ int rhod_write_bytes_atomic(const char *path, const void *data, size_t len, char
   return RHOD_OK;
 }
 
-/* Whole files in (scene text, checkpoints): io.h. */
-int rhod_read_file(const char *path, char **text, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f)
+/* Whole files in (scene text, checkpoints): io.h. Opened without blocking (a FIFO with
+ * no writer must not hang the open), refused unless a regular file (a device such as
+ * /dev/zero or a FIFO would be read forever), and never read past max bytes: a file that
+ * grows while it is read is cut off there and refused as too large. */
+int rhod_read_file(const char *path, size_t max, char **text, size_t *len) {
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0)
     return errno ? errno : EIO;
-  size_t cap = 4096, n = 0;
+  struct stat st;
+  if (fstat(fd, &st) != 0) {
+    const int e = errno ? errno : EIO;
+    (void)close(fd);
+    return e;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    (void)close(fd);
+    return S_ISDIR(st.st_mode) ? EISDIR : RHOD_READ_NOT_REGULAR;
+  }
+  if (st.st_size < 0 || (uint64_t)st.st_size > (uint64_t)max) {
+    (void)close(fd);
+    return RHOD_READ_TOO_LARGE;
+  }
+  /* room for the size fstat gave, plus one byte to see a file that grew */
+  size_t cap = (size_t)st.st_size + 2, n = 0;
+  if (cap < 64)
+    cap = 64;
   char *buf = malloc(cap);
-  int e = 0;
-  while (buf) {
+  int e = buf ? 0 : ENOMEM;
+  while (!e) {
     if (n + 1 >= cap) {
-      char *nb = realloc(buf, cap *= 2);
-      if (!nb) {
-        free(buf);
-        buf = NULL;
+      if (n > max) { /* grew past the limit while being read */
+        e = RHOD_READ_TOO_LARGE;
         break;
       }
-      buf = nb;
+      size_t ncap = cap > SIZE_MAX / 2 ? SIZE_MAX : cap * 2;
+      if (ncap > max + 2 && max + 2 > cap)
+        ncap = max + 2;
+      char *nb = realloc(buf, ncap);
+      if (!nb) {
+        e = ENOMEM;
+        break;
+      }
+      buf = nb, cap = ncap;
     }
-    size_t got = fread(buf + n, 1, cap - n - 1, f);
-    n += got;
-    if (got == 0) {
-      if (ferror(f))
-        e = errno ? errno : EIO;
+    const ssize_t got = read(fd, buf + n, cap - n - 1);
+    if (got < 0) {
+      if (errno == EINTR)
+        continue;
+      e = errno ? errno : EIO;
       break;
     }
+    if (got == 0)
+      break;
+    n += (size_t)got;
   }
-  fclose(f);
-  if (!buf)
-    return ENOMEM;
+  (void)close(fd);
+  if (!e && n > max)
+    e = RHOD_READ_TOO_LARGE;
   if (e) {
     free(buf);
     return e;
@@ -134,6 +163,16 @@ int rhod_read_file(const char *path, char **text, size_t *len) {
   *text = buf;
   *len = n;
   return 0;
+}
+
+const char *rhod_read_strerror(int e) {
+  if (e == RHOD_READ_NOT_REGULAR)
+    return "not a regular file";
+  if (e == RHOD_READ_TOO_LARGE)
+    return "too large";
+  if (e == EISDIR)
+    return "a directory, not a regular file";
+  return strerror(e);
 }
 
 int rhod_write_file_atomic(const char *path, const char *text, char *err, size_t errlen) {
