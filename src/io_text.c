@@ -7,6 +7,8 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdarg.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -254,16 +256,95 @@ int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *con
   return csv_finish(c, f, ncols, e, err, errlen);
 }
 
+/* The fields of a CSV line (RFC 4180 quoting), or 0 when a quote is left open. */
+static unsigned csv_fields(const char *s, size_t n) {
+  unsigned k = 1;
+  int q = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (s[i] == '"')
+      q = !q;
+    else if (s[i] == ',' && !q)
+      k++;
+  }
+  return q ? 0 : k;
+}
+
+static int reopen_fail(rhod_csv *c, int fd, int rc, char *err, size_t errlen, const char *fmt,
+                       ...) {
+  if (fd >= 0)
+    (void)close(fd);
+  if (err && errlen) {
+    char msg[300];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    snprintf(err, errlen, "%s: %s", c->path, msg);
+  }
+  free(c->path);
+  c->path = NULL;
+  return rc;
+}
+
 int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
                     size_t errlen) {
   if (csv_start(c, path, err, errlen) != RHOD_OK)
     return RHOD_ERR_MEMORY;
+  const int ck = RHOD_ERR_CHECKPOINT;
+  const unsigned long long want = (unsigned long long)bytes;
+  if (bytes == 0 || bytes > (uint64_t)INT64_MAX)
+    return reopen_fail(c, -1, ck, err, errlen, "the checkpoint records an impossible length, %llu",
+                       want);
+  int fd = open(path, O_RDWR | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    const int e = errno ? errno : EIO;
+    if (e == ENOENT)
+      return reopen_fail(c, -1, ck, err, errlen,
+                         "missing (the checkpoint needs its first %llu bytes)", want);
+    return reopen_fail(c, -1, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(e));
+  }
+  struct stat st;
+  if (fstat(fd, &st) != 0)
+    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(errno));
+  if (!S_ISREG(st.st_mode))
+    return reopen_fail(c, fd, ck, err, errlen, "not a regular file");
+  /* never lengthen it: ftruncate would pad a shorter file with NUL bytes */
+  if ((uint64_t)st.st_size < bytes)
+    return reopen_fail(c, fd, ck, err, errlen,
+                       "%lld bytes, shorter than the %llu the checkpoint recorded",
+                       (long long)st.st_size, want);
+  /* the header names t and the ncols probe columns; byte `bytes` ends a row */
+  char head[65536];
+  const size_t hn = bytes < sizeof head ? (size_t)bytes : sizeof head;
+  ssize_t got;
+  do
+    got = pread(fd, head, hn, 0);
+  while (got < 0 && errno == EINTR);
+  if (got < 0)
+    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot read: %s", strerror(errno));
+  const char *eol = memchr(head, '\n', (size_t)got);
+  if (!eol || (size_t)got < 2 || head[0] != 't' || (head[1] != ',' && head[1] != '\n') ||
+      csv_fields(head, (size_t)(eol - head)) != ncols + 1)
+    return reopen_fail(c, fd, ck, err, errlen, "the header is not t and the %u probe columns",
+                       ncols);
+  char last = 0;
+  do
+    got = pread(fd, &last, 1, (off_t)(bytes - 1));
+  while (got < 0 && errno == EINTR);
+  if (got != 1 || last != '\n')
+    return reopen_fail(c, fd, ck, err, errlen,
+                       "byte %llu does not end a row (the file is not the checkpoint's)", want);
+  if (ftruncate(fd, (off_t)bytes) != 0 || lseek(fd, 0, SEEK_END) < 0)
+    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(errno));
+  const int fl = fcntl(fd, F_GETFL);
+  if (fl < 0 || fcntl(fd, F_SETFL, (fl & ~O_NONBLOCK) | O_APPEND) != 0)
+    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(errno));
   errno = 0;
-  FILE *f = NULL;
-  int e = 0;
-  if (bytes == 0 || truncate(path, (off_t)bytes) != 0 || !(f = fopen(path, "a")))
-    e = errno ? errno : EIO;
-  return csv_finish(c, f, ncols, e, err, errlen);
+  FILE *f = fdopen(fd, "a");
+  if (!f)
+    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s",
+                       strerror(errno ? errno : EIO));
+  return csv_finish(c, f, ncols, 0, err, errlen);
 }
 
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen) {

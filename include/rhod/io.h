@@ -77,7 +77,10 @@ typedef struct {
 int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *const *names,
                   char *err, size_t errlen);
 /* Reopens an existing probes.csv for appending after cutting it to `bytes` (its length
- * at a checkpoint: rows written after it are dropped, the resumed run writes them again). */
+ * at a checkpoint: rows written after it are dropped, the resumed run writes them again).
+ * Never lengthens it: a file shorter than `bytes`, missing, not a regular file, whose
+ * header does not hold t and ncols columns or whose byte `bytes` does not end a row is
+ * refused with RHOD_ERR_CHECKPOINT ("path: reason"); failing writes give RHOD_ERR_IO. */
 int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
                     size_t errlen);
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen);
