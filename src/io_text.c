@@ -269,20 +269,94 @@ static unsigned csv_fields(const char *s, size_t n) {
   return q ? 0 : k;
 }
 
-static int reopen_fail(rhod_csv *c, int fd, int rc, char *err, size_t errlen, const char *fmt,
-                       ...) {
-  if (fd >= 0)
-    (void)close(fd);
+static int csv_refuse(char *err, size_t errlen, const char *path, int rc, const char *fmt, ...) {
   if (err && errlen) {
     char msg[300];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    snprintf(err, errlen, "%s: %s", c->path, msg);
+    snprintf(err, errlen, "%s: %s", path, msg);
   }
-  free(c->path);
-  c->path = NULL;
+  return rc;
+}
+
+/* Opens path (flags: O_RDONLY or O_RDWR, never blocking) and checks that it can be the
+ * probes.csv a checkpoint recorded `bytes` of: a regular file at least that long, whose
+ * first line is a header starting with t (of ncols probe columns, ncols >= 0) and whose
+ * byte `bytes` ends a row. Returns the descriptor in *fd or an error (closed). */
+static int csv_check_fd(const char *path, int flags, int ncols, uint64_t bytes, int *fd_out,
+                        char *err, size_t errlen) {
+  const int ck = RHOD_ERR_CHECKPOINT;
+  const unsigned long long want = (unsigned long long)bytes;
+  *fd_out = -1;
+  if (bytes < 2 || bytes > (uint64_t)INT64_MAX)
+    return csv_refuse(err, errlen, path, ck, "the checkpoint records an impossible length, %llu",
+                      want);
+  const int fd = open(path, flags | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    const int e = errno ? errno : EIO;
+    if (e == ENOENT)
+      return csv_refuse(err, errlen, path, ck,
+                        "missing (the checkpoint needs its first %llu bytes)", want);
+    return csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot %s: %s",
+                      flags == O_RDONLY ? "read" : "write", strerror(e));
+  }
+  struct stat st;
+  int rc = RHOD_OK;
+  char head[65536];
+  ssize_t got;
+  char last = 0;
+  if (fstat(fd, &st) != 0) {
+    rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot read: %s", strerror(errno));
+    goto out;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    rc = csv_refuse(err, errlen, path, ck, "not a regular file");
+    goto out;
+  }
+  /* never lengthen it: ftruncate would pad a shorter file with NUL bytes */
+  if ((uint64_t)st.st_size < bytes) {
+    rc = csv_refuse(err, errlen, path, ck,
+                    "%lld bytes, shorter than the %llu the checkpoint recorded",
+                    (long long)st.st_size, want);
+    goto out;
+  }
+  do
+    got = pread(fd, head, bytes < sizeof head ? (size_t)bytes : sizeof head, 0);
+  while (got < 0 && errno == EINTR);
+  if (got < 0) {
+    rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot read: %s", strerror(errno));
+    goto out;
+  }
+  const char *eol = memchr(head, '\n', (size_t)got);
+  if (!eol || head[0] != 't' || (head[1] != ',' && head[1] != '\n') ||
+      (ncols >= 0 && csv_fields(head, (size_t)(eol - head)) != (unsigned)ncols + 1)) {
+    if (ncols >= 0)
+      rc = csv_refuse(err, errlen, path, ck, "the header is not t and the %d probe columns", ncols);
+    else
+      rc = csv_refuse(err, errlen, path, ck, "the first line is not a header starting with t");
+    goto out;
+  }
+  do
+    got = pread(fd, &last, 1, (off_t)(bytes - 1));
+  while (got < 0 && errno == EINTR);
+  if (got != 1 || last != '\n')
+    rc = csv_refuse(err, errlen, path, ck,
+                    "byte %llu does not end a row (the file is not the checkpoint's)", want);
+out:
+  if (rc != RHOD_OK)
+    (void)close(fd);
+  else
+    *fd_out = fd;
+  return rc;
+}
+
+int rhod_csv_check(const char *path, uint64_t bytes, char *err, size_t errlen) {
+  int fd;
+  const int rc = csv_check_fd(path, O_RDONLY, -1, bytes, &fd, err, errlen);
+  if (rc == RHOD_OK)
+    (void)close(fd);
   return rc;
 }
 
@@ -290,60 +364,29 @@ int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t byte
                     size_t errlen) {
   if (csv_start(c, path, err, errlen) != RHOD_OK)
     return RHOD_ERR_MEMORY;
-  const int ck = RHOD_ERR_CHECKPOINT;
-  const unsigned long long want = (unsigned long long)bytes;
-  if (bytes == 0 || bytes > (uint64_t)INT64_MAX)
-    return reopen_fail(c, -1, ck, err, errlen, "the checkpoint records an impossible length, %llu",
-                       want);
-  int fd = open(path, O_RDWR | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) {
-    const int e = errno ? errno : EIO;
-    if (e == ENOENT)
-      return reopen_fail(c, -1, ck, err, errlen,
-                         "missing (the checkpoint needs its first %llu bytes)", want);
-    return reopen_fail(c, -1, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(e));
+  int fd = -1;
+  int rc = ncols > 100000 ? csv_refuse(err, errlen, path, RHOD_ERR_CHECKPOINT, "%u columns", ncols)
+                          : csv_check_fd(path, O_RDWR, (int)ncols, bytes, &fd, err, errlen);
+  if (rc == RHOD_OK) {
+    const int fl = fcntl(fd, F_GETFL);
+    if (ftruncate(fd, (off_t)bytes) != 0 || lseek(fd, 0, SEEK_END) < 0 || fl < 0 ||
+        fcntl(fd, F_SETFL, (fl & ~O_NONBLOCK) | O_APPEND) != 0)
+      rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot write: %s", strerror(errno));
   }
-  struct stat st;
-  if (fstat(fd, &st) != 0)
-    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(errno));
-  if (!S_ISREG(st.st_mode))
-    return reopen_fail(c, fd, ck, err, errlen, "not a regular file");
-  /* never lengthen it: ftruncate would pad a shorter file with NUL bytes */
-  if ((uint64_t)st.st_size < bytes)
-    return reopen_fail(c, fd, ck, err, errlen,
-                       "%lld bytes, shorter than the %llu the checkpoint recorded",
-                       (long long)st.st_size, want);
-  /* the header names t and the ncols probe columns; byte `bytes` ends a row */
-  char head[65536];
-  const size_t hn = bytes < sizeof head ? (size_t)bytes : sizeof head;
-  ssize_t got;
-  do
-    got = pread(fd, head, hn, 0);
-  while (got < 0 && errno == EINTR);
-  if (got < 0)
-    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot read: %s", strerror(errno));
-  const char *eol = memchr(head, '\n', (size_t)got);
-  if (!eol || (size_t)got < 2 || head[0] != 't' || (head[1] != ',' && head[1] != '\n') ||
-      csv_fields(head, (size_t)(eol - head)) != ncols + 1)
-    return reopen_fail(c, fd, ck, err, errlen, "the header is not t and the %u probe columns",
-                       ncols);
-  char last = 0;
-  do
-    got = pread(fd, &last, 1, (off_t)(bytes - 1));
-  while (got < 0 && errno == EINTR);
-  if (got != 1 || last != '\n')
-    return reopen_fail(c, fd, ck, err, errlen,
-                       "byte %llu does not end a row (the file is not the checkpoint's)", want);
-  if (ftruncate(fd, (off_t)bytes) != 0 || lseek(fd, 0, SEEK_END) < 0)
-    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(errno));
-  const int fl = fcntl(fd, F_GETFL);
-  if (fl < 0 || fcntl(fd, F_SETFL, (fl & ~O_NONBLOCK) | O_APPEND) != 0)
-    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s", strerror(errno));
-  errno = 0;
-  FILE *f = fdopen(fd, "a");
-  if (!f)
-    return reopen_fail(c, fd, RHOD_ERR_IO, err, errlen, "cannot write: %s",
-                       strerror(errno ? errno : EIO));
+  FILE *f = NULL;
+  if (rc == RHOD_OK) {
+    errno = 0;
+    if (!(f = fdopen(fd, "a")))
+      rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot write: %s",
+                      strerror(errno ? errno : EIO));
+  }
+  if (rc != RHOD_OK) {
+    if (fd >= 0)
+      (void)close(fd);
+    free(c->path);
+    c->path = NULL;
+    return rc;
+  }
   return csv_finish(c, f, ncols, 0, err, errlen);
 }
 

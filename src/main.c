@@ -238,6 +238,11 @@ static int cmd_run(int argc, char **argv, const char *resume_out) {
     char path[4200];
     snprintf(path, sizeof path, "%s/checkpoint.rhod", resume_out);
     int st = rhod_checkpoint_read(path, &ck, err, sizeof err);
+    if (st == RHOD_OK) { /* probes.csv as long as recorded: refused before anything is written */
+      snprintf(path, sizeof path, "%s/probes.csv", resume_out);
+      if ((st = rhod_csv_check(path, ck.probes_bytes, err, sizeof err)) != RHOD_OK)
+        rhod_checkpoint_free(&ck);
+    }
     if (st != RHOD_OK) {
       fprintf(stderr, "rhod: %s\n", err);
       return st;

@@ -83,6 +83,9 @@ int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *con
  * refused with RHOD_ERR_CHECKPOINT ("path: reason"); failing writes give RHOD_ERR_IO. */
 int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
                     size_t errlen);
+/* The same checks (but the header's column count) without changing anything: for a
+ * resume to refuse a probes.csv before it writes anything. */
+int rhod_csv_check(const char *path, uint64_t bytes, char *err, size_t errlen);
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen);
 int rhod_csv_close(rhod_csv *c, char *err, size_t errlen);
 
