@@ -4,6 +4,7 @@
  *   i64 step reflected splits merges (version 2; version 1 has no splits, merges)
  *   f64 stiffness (version 3)
  *   i64 absorbed, f64 ke_merged ke_absorbed (version 4)
+ *   f64 picture_range[2] (version 5; NaN NaN: no range fixed yet)
  *   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
  *   str scene_path   i32 nsets, str[nsets]   u32 nparams, (str key, str value)[nparams]
  *   u64 n next_id   i32 nfields, per field: str name, u64 elem, elem * n bytes
@@ -21,9 +22,11 @@
 
 #define CK_MAGIC "RHODCKP1"
 /* 2: the split and merge totals; 3: the stiffness limit's measure; 4: the absorbed
- * stragglers' total and the energy coalescing took out; 1 to 3 are still read */
-#define CK_VERSION 4u
+ * stragglers' total and the energy coalescing took out; 5: the pictures' colour range
+ * fixed at the first picture; 1 to 4 are still read */
+#define CK_VERSION 5u
 #define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
+#define CK_MAX_PROBES_BYTES ((uint64_t)1 << 40) /* probes.csv: 1 TiB */
 
 static uint64_t fnv1a(const unsigned char *b, size_t n) {
   uint64_t h = 1469598103934665603ull;
@@ -88,6 +91,8 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
   put_i64(&w, ck->absorbed);
   put_f64(&w, ck->ke_merged);
   put_f64(&w, ck->ke_absorbed);
+  put_f64(&w, ck->picture_range[0]);
+  put_f64(&w, ck->picture_range[1]);
   put_u64(&w, ck->probes_bytes);
   put_i32(&w, ck->nsnap);
   put(&w, ck->snap_t, sizeof(double) * (size_t)ck->nsnap);
@@ -162,8 +167,12 @@ static uint32_t get_count(rd *r, const char *what) {
 }
 
 static char *get_str(rd *r, const char *what) {
+  if (r->bad) /* keep the first record that did not fit */
+    return NULL;
   const uint32_t n = get_count(r, what);
-  if (r->bad || n > r->len - r->pos) {
+  if (r->bad)
+    return NULL;
+  if (n > r->len - r->pos) {
     r->bad = 1;
     r->what = what;
     return NULL;
@@ -211,6 +220,168 @@ static int read_fail(char *err, size_t errlen, const char *path, const char *fmt
   return RHOD_ERR_CHECKPOINT;
 }
 
+/* ------------------------------------------------------------------ validation */
+
+/* A checksum only says the bytes are as written; a file written (or rewritten with a new
+ * checksum) by anything else must still not resume into NaN times, an endless catch-up
+ * loop, zero masses or a probes.csv padded to a terabyte. Every field is range-checked;
+ * the message names it: "path: field NAME: reason". */
+static int bad_field(char *err, size_t errlen, const char *path, const char *field, const char *fmt,
+                     ...) {
+  char msg[400];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  snprintf(err, errlen, "%s: field %s: %s", path, field, msg);
+  return RHOD_ERR_CHECKPOINT;
+}
+
+/* A clock value: finite and >= 0. */
+static int bad_time(double v) { return !(v >= 0 && v < HUGE_VAL); }
+
+/* The clock after adding step to v moves (a step below v's resolution would make the
+ * run's "advance to the next output" loop endless). */
+static int too_fine(double v, double step) { return !(v + step > v); }
+
+static int cmp_u64(const void *a, const void *b) {
+  const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return (x > y) - (x < y);
+}
+
+/* The engine's own fields (particles.c): the real-valued ones are finite, the mass,
+ * density and size positive; ids unique and below next_id. */
+static int validate_particles(const rhod_checkpoint *ck, const char *path, char *err,
+                              size_t errlen) {
+  static const struct {
+    const char *name;
+    int positive;
+  } reals[] = {{"x", 0}, {"y", 0}, {"ux", 0}, {"uy", 0}, {"rho", 1}, {"m", 1}, {"dx", 1}};
+  for (int f = 0; f < ck->nfields; f++) {
+    const char *name = ck->fname[f];
+    if (!strcmp(name, "id")) {
+      if (ck->felem[f] != sizeof(uint64_t))
+        return bad_field(err, errlen, path, name, "%llu bytes per particle, expected %zu",
+                         (unsigned long long)ck->felem[f], sizeof(uint64_t));
+      const uint64_t *id = ck->fdata[f];
+      uint64_t *sorted = malloc(sizeof(uint64_t) * (size_t)(ck->n ? ck->n : 1));
+      if (!sorted) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        return RHOD_ERR_MEMORY;
+      }
+      memcpy(sorted, id, sizeof(uint64_t) * (size_t)ck->n);
+      qsort(sorted, (size_t)ck->n, sizeof(uint64_t), cmp_u64);
+      int rc = RHOD_OK;
+      for (uint64_t i = 1; i < ck->n && rc == RHOD_OK; i++)
+        if (sorted[i] == sorted[i - 1])
+          rc = bad_field(err, errlen, path, name, "id %llu appears more than once",
+                         (unsigned long long)sorted[i]);
+      if (rc == RHOD_OK && ck->n > 0 && sorted[ck->n - 1] >= ck->next_id)
+        rc = bad_field(err, errlen, path, "next_id", "%llu, not above the largest id %llu",
+                       (unsigned long long)ck->next_id, (unsigned long long)sorted[ck->n - 1]);
+      free(sorted);
+      if (rc != RHOD_OK)
+        return rc;
+      continue;
+    }
+    for (size_t k = 0; k < sizeof reals / sizeof reals[0]; k++) {
+      if (strcmp(name, reals[k].name) != 0)
+        continue;
+      if (ck->felem[f] != sizeof(real))
+        return bad_field(err, errlen, path, name, "%llu bytes per particle, expected %zu",
+                         (unsigned long long)ck->felem[f], sizeof(real));
+      const real *v = ck->fdata[f];
+      for (uint64_t i = 0; i < ck->n; i++) {
+        const double x = (double)v[i];
+        if (!isfinite(x))
+          return bad_field(err, errlen, path, name, "particle %llu: not a finite number",
+                           (unsigned long long)i);
+        if (reals[k].positive && !(x > 0))
+          return bad_field(err, errlen, path, name, "particle %llu: %g, must be > 0",
+                           (unsigned long long)i, x);
+      }
+    }
+  }
+  return RHOD_OK;
+}
+
+static int validate(const rhod_checkpoint *ck, const char *path, char *err, size_t errlen) {
+  const double t = ck->t;
+  if (bad_time(t))
+    return bad_field(err, errlen, path, "t", "%g, must be a finite time >= 0", t);
+  const struct {
+    const char *name;
+    double v;
+  } next[] = {{"next_out", ck->next_out}, {"next_probe", ck->next_probe}};
+  for (int i = 0; i < 2; i++) {
+    if (bad_time(next[i].v))
+      return bad_field(err, errlen, path, next[i].name, "%g, must be a finite time >= 0",
+                       next[i].v);
+    if (next[i].v < t)
+      return bad_field(err, errlen, path, next[i].name, "%.17g, before the time t = %.17g",
+                       next[i].v, t);
+  }
+  const double every = ck->checkpoint_every, nck = ck->next_checkpoint;
+  if (bad_time(every))
+    return bad_field(err, errlen, path, "checkpoint_every", "%g, must be a finite time >= 0",
+                     every);
+  if (bad_time(nck))
+    return bad_field(err, errlen, path, "next_checkpoint", "%g, must be a finite time >= 0", nck);
+  if (every > 0 && nck < t)
+    return bad_field(err, errlen, path, "next_checkpoint", "%.17g, before the time t = %.17g", nck,
+                     t);
+  if (every > 0 && too_fine(nck, every))
+    return bad_field(err, errlen, path, "checkpoint_every",
+                     "%g, too small to advance the clock from %g", every, nck);
+  const struct {
+    const char *name;
+    int64_t v;
+  } counts[] = {{"step", ck->step},
+                {"reflected", ck->reflected},
+                {"splits", ck->splits},
+                {"merges", ck->merges},
+                {"absorbed", ck->absorbed}};
+  for (int i = 0; i < 5; i++)
+    if (counts[i].v < 0)
+      return bad_field(err, errlen, path, counts[i].name, "%lld, must be >= 0",
+                       (long long)counts[i].v);
+  if (!(ck->stiffness >= 0 && ck->stiffness < HUGE_VAL))
+    return bad_field(err, errlen, path, "stiffness", "%g, must be finite and >= 0", ck->stiffness);
+  if (!isfinite(ck->ke_merged))
+    return bad_field(err, errlen, path, "ke_merged", "not a finite number");
+  if (!isfinite(ck->ke_absorbed))
+    return bad_field(err, errlen, path, "ke_absorbed", "not a finite number");
+  const double *pr = ck->picture_range;
+  if (!(isnan(pr[0]) && isnan(pr[1])) && !(isfinite(pr[0]) && isfinite(pr[1]) && pr[0] < pr[1]))
+    return bad_field(err, errlen, path, "picture_range",
+                     "neither unset (NaN, NaN) nor finite with low < high");
+  /* the header line at least; at most 1 TiB (a longer probes.csv is not a real run's) */
+  if (ck->probes_bytes < 2 || ck->probes_bytes > CK_MAX_PROBES_BYTES)
+    return bad_field(err, errlen, path, "probes_bytes", "%llu, must be 2 to %llu",
+                     (unsigned long long)ck->probes_bytes, (unsigned long long)CK_MAX_PROBES_BYTES);
+  if (ck->nsnap < 0)
+    return bad_field(err, errlen, path, "nsnap", "%d, must be >= 0", (int)ck->nsnap);
+  for (int32_t i = 0; i < ck->nsnap; i++) {
+    const double ts = ck->snap_t[i];
+    if (bad_time(ts) || ts > t)
+      return bad_field(err, errlen, path, "snap_t", "snapshot %d at %g, must be 0 to t = %g",
+                       (int)i, ts, t);
+    if (i > 0 && ts < ck->snap_t[i - 1])
+      return bad_field(err, errlen, path, "snap_t", "snapshot %d at %g, before snapshot %d", (int)i,
+                       ts, (int)i - 1);
+    if (ck->snap_n[i] > CK_MAX_COUNT)
+      return bad_field(err, errlen, path, "snap_n", "snapshot %d: %llu particles, at most %u",
+                       (int)i, (unsigned long long)ck->snap_n[i], CK_MAX_COUNT);
+  }
+  if (ck->n > CK_MAX_COUNT)
+    return bad_field(err, errlen, path, "n", "%llu particles, at most %u",
+                     (unsigned long long)ck->n, CK_MAX_COUNT);
+  if (ck->next_id < ck->n)
+    return bad_field(err, errlen, path, "next_id", "%llu, fewer than the %llu particles",
+                     (unsigned long long)ck->next_id, (unsigned long long)ck->n);
+  return validate_particles(ck, path, err, errlen);
+}
+
 static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t errlen) {
   char magic[8];
   uint32_t version = 0, rsize = 0;
@@ -227,44 +398,49 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   if (rsize != sizeof(real))
     return read_fail(err, errlen, path, "written by a %s-precision build, this one is %s",
                      rsize == 4 ? "single" : "double", RHOD_REAL_NAME);
-  get(r, &ck->t, 8, "time");
-  get(r, &ck->next_out, 8, "next output time");
-  get(r, &ck->next_probe, 8, "next probe time");
-  get(r, &ck->next_checkpoint, 8, "next checkpoint time");
-  get(r, &ck->checkpoint_every, 8, "checkpoint interval");
+  get(r, &ck->t, 8, "t");
+  get(r, &ck->next_out, 8, "next_out");
+  get(r, &ck->next_probe, 8, "next_probe");
+  get(r, &ck->next_checkpoint, 8, "next_checkpoint");
+  get(r, &ck->checkpoint_every, 8, "checkpoint_every");
   get(r, &ck->step, 8, "step");
-  get(r, &ck->reflected, 8, "reflection count");
+  get(r, &ck->reflected, 8, "reflected");
   if (version >= 2) {
-    get(r, &ck->splits, 8, "split count");
-    get(r, &ck->merges, 8, "merge count");
+    get(r, &ck->splits, 8, "splits");
+    get(r, &ck->merges, 8, "merges");
   }
   if (version >= 3)
     get(r, &ck->stiffness, 8, "stiffness");
   if (version >= 4) {
-    get(r, &ck->absorbed, 8, "absorbed count");
-    get(r, &ck->ke_merged, 8, "energy merged");
-    get(r, &ck->ke_absorbed, 8, "energy absorbed");
+    get(r, &ck->absorbed, 8, "absorbed");
+    get(r, &ck->ke_merged, 8, "ke_merged");
+    get(r, &ck->ke_absorbed, 8, "ke_absorbed");
   }
-  get(r, &ck->probes_bytes, 8, "probes.csv length");
-  ck->nsnap = (int32_t)get_count(r, "snapshot count");
-  ck->snap_t = get_array(r, (uint64_t)ck->nsnap, sizeof(double), "snapshot times");
-  ck->snap_n = get_array(r, (uint64_t)ck->nsnap, sizeof(uint64_t), "snapshot sizes");
-  ck->scene_path = get_str(r, "scene path");
-  ck->nsets = (int32_t)get_count(r, "override count");
+  ck->picture_range[0] = ck->picture_range[1] = NAN;
+  if (version >= 5) {
+    get(r, &ck->picture_range[0], 8, "picture_range");
+    get(r, &ck->picture_range[1], 8, "picture_range");
+  }
+  get(r, &ck->probes_bytes, 8, "probes_bytes");
+  ck->nsnap = (int32_t)get_count(r, "nsnap");
+  ck->snap_t = get_array(r, (uint64_t)ck->nsnap, sizeof(double), "snap_t");
+  ck->snap_n = get_array(r, (uint64_t)ck->nsnap, sizeof(uint64_t), "snap_n");
+  ck->scene_path = get_str(r, "scene_path");
+  ck->nsets = (int32_t)get_count(r, "nsets");
   /* every string takes at least its 4-byte length: bound counts by the bytes left
    * before allocating (a hostile count must not cost memory) */
   if (!r->bad && (size_t)ck->nsets > (r->len - r->pos) / 4) {
     r->bad = 1;
-    r->what = "override count";
+    r->what = "nsets";
   }
   if (!r->bad && !(ck->sets = calloc((size_t)ck->nsets + 1, sizeof(char *))))
     r->bad = 2;
   for (int i = 0; i < ck->nsets && !r->bad && ck->sets; i++)
-    ck->sets[i] = get_str(r, "override");
-  const uint32_t np = get_count(r, "parameter count");
+    ck->sets[i] = get_str(r, "sets");
+  const uint32_t np = get_count(r, "nparams");
   if (!r->bad && np > (r->len - r->pos) / 8) {
     r->bad = 1;
-    r->what = "parameter count";
+    r->what = "nparams";
   }
   if (!r->bad) {
     ck->params.keys = calloc((size_t)np + 1, sizeof(char *));
@@ -273,16 +449,16 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
       r->bad = 2;
   }
   for (uint32_t i = 0; i < np && !r->bad; i++) {
-    ck->params.keys[i] = get_str(r, "parameter key");
-    ck->params.values[i] = get_str(r, "parameter value");
+    ck->params.keys[i] = get_str(r, "param key");
+    ck->params.values[i] = get_str(r, "param value");
     ck->params.n = i + 1;
   }
-  get(r, &ck->n, 8, "particle count");
-  get(r, &ck->next_id, 8, "next id");
-  ck->nfields = (int32_t)get_count(r, "field count");
+  get(r, &ck->n, 8, "n");
+  get(r, &ck->next_id, 8, "next_id");
+  ck->nfields = (int32_t)get_count(r, "nfields");
   if (!r->bad && ck->nfields > RHOD_MAX_FIELDS) {
     r->bad = 1;
-    r->what = "field count";
+    r->what = "nfields";
   }
   if (!r->bad) {
     ck->fname = calloc((size_t)ck->nfields + 1, sizeof(char *));
@@ -293,10 +469,10 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   }
   for (int f = 0; f < ck->nfields && !r->bad; f++) {
     ck->fname[f] = get_str(r, "field name");
-    get(r, &ck->felem[f], 8, "field element size");
+    get(r, &ck->felem[f], 8, "field elem");
     if (!r->bad && (ck->felem[f] == 0 || ck->felem[f] > 4096)) {
       r->bad = 1;
-      r->what = "field element size";
+      r->what = "field elem";
       break;
     }
     ck->fdata[f] = get_array(r, ck->n, (size_t)ck->felem[f], "field data");
@@ -306,31 +482,32 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
     return RHOD_ERR_MEMORY;
   }
   if (r->bad)
-    return read_fail(err, errlen, path, "damaged: %s does not fit in the file", r->what);
+    return read_fail(err, errlen, path, "damaged: field %s: does not fit in the file", r->what);
   if (r->len - r->pos != 8)
     return read_fail(err, errlen, path, "damaged: the checksum is missing or not at the end");
   uint64_t h;
   memcpy(&h, r->b + r->pos, 8);
   if (h != fnv1a(r->b, r->pos))
     return read_fail(err, errlen, path, "damaged: checksum mismatch");
-  if (!(ck->t >= 0) || ck->step < 0 || ck->nsnap < 0)
-    return read_fail(err, errlen, path, "damaged: negative time, step or snapshot count");
-  if (!(ck->stiffness >= 0 && ck->stiffness < HUGE_VAL))
-    return read_fail(err, errlen, path, "damaged: stiffness not finite and non-negative");
-  return RHOD_OK;
+  return validate(ck, path, err, errlen);
 }
 
 int rhod_checkpoint_read(const char *path, rhod_checkpoint *ck, char *err, size_t errlen) {
   memset(ck, 0, sizeof *ck);
   char *b = NULL;
   size_t len = 0;
-  const int e = rhod_read_file(path, &b, &len);
+  const size_t max =
+      RHOD_CHECKPOINT_MAX_BYTES < SIZE_MAX / 2 ? (size_t)RHOD_CHECKPOINT_MAX_BYTES : SIZE_MAX / 2;
+  const int e = rhod_read_file(path, max, &b, &len);
   if (e == ENOMEM) {
     snprintf(err, errlen, "%s: out of memory", path);
     return RHOD_ERR_MEMORY;
   }
+  if (e == RHOD_READ_TOO_LARGE)
+    return read_fail(err, errlen, path, "cannot read the checkpoint: larger than %llu GiB",
+                     (unsigned long long)(max >> 30));
   if (e)
-    return read_fail(err, errlen, path, "cannot read the checkpoint: %s", strerror(e));
+    return read_fail(err, errlen, path, "cannot read the checkpoint: %s", rhod_read_strerror(e));
   int rc = rhod_checkpoint_parse(b, len, path, ck, err, errlen);
   free(b);
   return rc;

@@ -7,6 +7,8 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdarg.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -97,35 +99,64 @@ int rhod_write_bytes_atomic(const char *path, const void *data, size_t len, char
   return RHOD_OK;
 }
 
-/* Whole files in (scene text, checkpoints): io.h. */
-int rhod_read_file(const char *path, char **text, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f)
+/* Whole files in (scene text, checkpoints): io.h. Opened without blocking (a FIFO with
+ * no writer must not hang the open), refused unless a regular file (a device such as
+ * /dev/zero or a FIFO would be read forever), and never read past max bytes: a file that
+ * grows while it is read is cut off there and refused as too large. */
+int rhod_read_file(const char *path, size_t max, char **text, size_t *len) {
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0)
     return errno ? errno : EIO;
-  size_t cap = 4096, n = 0;
+  struct stat st;
+  if (fstat(fd, &st) != 0) {
+    const int e = errno ? errno : EIO;
+    (void)close(fd);
+    return e;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    (void)close(fd);
+    return S_ISDIR(st.st_mode) ? EISDIR : RHOD_READ_NOT_REGULAR;
+  }
+  if (st.st_size < 0 || (uint64_t)st.st_size > (uint64_t)max) {
+    (void)close(fd);
+    return RHOD_READ_TOO_LARGE;
+  }
+  /* room for the size fstat gave, plus one byte to see a file that grew */
+  size_t cap = (size_t)st.st_size + 2, n = 0;
+  if (cap < 64)
+    cap = 64;
   char *buf = malloc(cap);
-  int e = 0;
-  while (buf) {
+  int e = buf ? 0 : ENOMEM;
+  while (!e) {
     if (n + 1 >= cap) {
-      char *nb = realloc(buf, cap *= 2);
-      if (!nb) {
-        free(buf);
-        buf = NULL;
+      if (n > max) { /* grew past the limit while being read */
+        e = RHOD_READ_TOO_LARGE;
         break;
       }
-      buf = nb;
+      size_t ncap = cap > SIZE_MAX / 2 ? SIZE_MAX : cap * 2;
+      if (ncap > max + 2 && max + 2 > cap)
+        ncap = max + 2;
+      char *nb = realloc(buf, ncap);
+      if (!nb) {
+        e = ENOMEM;
+        break;
+      }
+      buf = nb, cap = ncap;
     }
-    size_t got = fread(buf + n, 1, cap - n - 1, f);
-    n += got;
-    if (got == 0) {
-      if (ferror(f))
-        e = errno ? errno : EIO;
+    const ssize_t got = read(fd, buf + n, cap - n - 1);
+    if (got < 0) {
+      if (errno == EINTR)
+        continue;
+      e = errno ? errno : EIO;
       break;
     }
+    if (got == 0)
+      break;
+    n += (size_t)got;
   }
-  fclose(f);
-  if (!buf)
-    return ENOMEM;
+  (void)close(fd);
+  if (!e && n > max)
+    e = RHOD_READ_TOO_LARGE;
   if (e) {
     free(buf);
     return e;
@@ -134,6 +165,16 @@ int rhod_read_file(const char *path, char **text, size_t *len) {
   *text = buf;
   *len = n;
   return 0;
+}
+
+const char *rhod_read_strerror(int e) {
+  if (e == RHOD_READ_NOT_REGULAR)
+    return "not a regular file";
+  if (e == RHOD_READ_TOO_LARGE)
+    return "too large";
+  if (e == EISDIR)
+    return "a directory, not a regular file";
+  return strerror(e);
 }
 
 int rhod_write_file_atomic(const char *path, const char *text, char *err, size_t errlen) {
@@ -215,16 +256,138 @@ int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *con
   return csv_finish(c, f, ncols, e, err, errlen);
 }
 
+/* The fields of a CSV line (RFC 4180 quoting), or 0 when a quote is left open. */
+static unsigned csv_fields(const char *s, size_t n) {
+  unsigned k = 1;
+  int q = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (s[i] == '"')
+      q = !q;
+    else if (s[i] == ',' && !q)
+      k++;
+  }
+  return q ? 0 : k;
+}
+
+static int csv_refuse(char *err, size_t errlen, const char *path, int rc, const char *fmt, ...) {
+  if (err && errlen) {
+    char msg[300];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    snprintf(err, errlen, "%s: %s", path, msg);
+  }
+  return rc;
+}
+
+/* Opens path (flags: O_RDONLY or O_RDWR, never blocking) and checks that it can be the
+ * probes.csv a checkpoint recorded `bytes` of: a regular file at least that long, whose
+ * first line is a header starting with t (of ncols probe columns, ncols >= 0) and whose
+ * byte `bytes` ends a row. Returns the descriptor in *fd or an error (closed). */
+static int csv_check_fd(const char *path, int flags, int ncols, uint64_t bytes, int *fd_out,
+                        char *err, size_t errlen) {
+  const int ck = RHOD_ERR_CHECKPOINT;
+  const unsigned long long want = (unsigned long long)bytes;
+  *fd_out = -1;
+  if (bytes < 2 || bytes > (uint64_t)INT64_MAX)
+    return csv_refuse(err, errlen, path, ck, "the checkpoint records an impossible length, %llu",
+                      want);
+  const int fd = open(path, flags | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    const int e = errno ? errno : EIO;
+    if (e == ENOENT)
+      return csv_refuse(err, errlen, path, ck,
+                        "missing (the checkpoint needs its first %llu bytes)", want);
+    return csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot %s: %s",
+                      flags == O_RDONLY ? "read" : "write", strerror(e));
+  }
+  struct stat st;
+  int rc = RHOD_OK;
+  char head[65536];
+  ssize_t got;
+  char last = 0;
+  if (fstat(fd, &st) != 0) {
+    rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot read: %s", strerror(errno));
+    goto out;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    rc = csv_refuse(err, errlen, path, ck, "not a regular file");
+    goto out;
+  }
+  /* never lengthen it: ftruncate would pad a shorter file with NUL bytes */
+  if ((uint64_t)st.st_size < bytes) {
+    rc = csv_refuse(err, errlen, path, ck,
+                    "%lld bytes, shorter than the %llu the checkpoint recorded",
+                    (long long)st.st_size, want);
+    goto out;
+  }
+  do
+    got = pread(fd, head, bytes < sizeof head ? (size_t)bytes : sizeof head, 0);
+  while (got < 0 && errno == EINTR);
+  if (got < 0) {
+    rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot read: %s", strerror(errno));
+    goto out;
+  }
+  const char *eol = memchr(head, '\n', (size_t)got);
+  if (!eol || head[0] != 't' || (head[1] != ',' && head[1] != '\n') ||
+      (ncols >= 0 && csv_fields(head, (size_t)(eol - head)) != (unsigned)ncols + 1)) {
+    if (ncols >= 0)
+      rc = csv_refuse(err, errlen, path, ck, "the header is not t and the %d probe columns", ncols);
+    else
+      rc = csv_refuse(err, errlen, path, ck, "the first line is not a header starting with t");
+    goto out;
+  }
+  do
+    got = pread(fd, &last, 1, (off_t)(bytes - 1));
+  while (got < 0 && errno == EINTR);
+  if (got != 1 || last != '\n')
+    rc = csv_refuse(err, errlen, path, ck,
+                    "byte %llu does not end a row (the file is not the checkpoint's)", want);
+out:
+  if (rc != RHOD_OK)
+    (void)close(fd);
+  else
+    *fd_out = fd;
+  return rc;
+}
+
+int rhod_csv_check(const char *path, uint64_t bytes, char *err, size_t errlen) {
+  int fd;
+  const int rc = csv_check_fd(path, O_RDONLY, -1, bytes, &fd, err, errlen);
+  if (rc == RHOD_OK)
+    (void)close(fd);
+  return rc;
+}
+
 int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
                     size_t errlen) {
   if (csv_start(c, path, err, errlen) != RHOD_OK)
     return RHOD_ERR_MEMORY;
-  errno = 0;
+  int fd = -1;
+  int rc = ncols > 100000 ? csv_refuse(err, errlen, path, RHOD_ERR_CHECKPOINT, "%u columns", ncols)
+                          : csv_check_fd(path, O_RDWR, (int)ncols, bytes, &fd, err, errlen);
+  if (rc == RHOD_OK) {
+    const int fl = fcntl(fd, F_GETFL);
+    if (ftruncate(fd, (off_t)bytes) != 0 || lseek(fd, 0, SEEK_END) < 0 || fl < 0 ||
+        fcntl(fd, F_SETFL, (fl & ~O_NONBLOCK) | O_APPEND) != 0)
+      rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot write: %s", strerror(errno));
+  }
   FILE *f = NULL;
-  int e = 0;
-  if (bytes == 0 || truncate(path, (off_t)bytes) != 0 || !(f = fopen(path, "a")))
-    e = errno ? errno : EIO;
-  return csv_finish(c, f, ncols, e, err, errlen);
+  if (rc == RHOD_OK) {
+    errno = 0;
+    if (!(f = fdopen(fd, "a")))
+      rc = csv_refuse(err, errlen, path, RHOD_ERR_IO, "cannot write: %s",
+                      strerror(errno ? errno : EIO));
+  }
+  if (rc != RHOD_OK) {
+    if (fd >= 0)
+      (void)close(fd);
+    free(c->path);
+    c->path = NULL;
+    return rc;
+  }
+  return csv_finish(c, f, ncols, 0, err, errlen);
 }
 
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen) {

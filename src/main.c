@@ -313,18 +313,9 @@ static int check_resume_files(const char *out, const rhod_checkpoint *ck, int *m
   char path[4200];
   *missing = 0;
   snprintf(path, sizeof path, "%s/probes.csv", out);
-  struct stat st;
-  if (stat(path, &st) != 0 || !S_ISREG(st.st_mode)) {
-    snprintf(err, len, "%.900s: missing or not a file: the checkpoint's run wrote it", path);
-    return RHOD_ERR_CHECKPOINT;
-  }
-  if ((uint64_t)st.st_size < ck->probes_bytes) {
-    snprintf(err, len,
-             "%.900s: %lld bytes, shorter than the %llu the checkpoint recorded: it is not the "
-             "checkpoint's run's file",
-             path, (long long)st.st_size, (unsigned long long)ck->probes_bytes);
-    return RHOD_ERR_CHECKPOINT;
-  }
+  const int st = rhod_csv_check(path, ck->probes_bytes, err, len);
+  if (st != RHOD_OK)
+    return st;
   for (int i = 0; i < ck->nsnap; i++) {
     snprintf(path, sizeof path, "%s/snapshot_%04d.h5", out, i);
     if (access(path, F_OK) != 0) {
@@ -371,7 +362,9 @@ typedef struct {
   const char **sets;
   int nsets;
   double ck_every, next_ck;
-  long step0; /* steps done before this process (a resume) */
+  long step0;          /* steps done before this process (a resume) */
+  double pic_range[2]; /* the pictures' colour range: given, or fixed at the first
+                          picture whose field has one (NaN, NaN before) */
 } run_ctx;
 
 /* OUT/checkpoint.rhod: the state at the top of the loop, after the outputs of time t. */
@@ -391,6 +384,8 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
   ck.ke_merged = c->sim.apr.ke_merged;
   ck.ke_absorbed = c->sim.apr.ke_absorbed;
   ck.stiffness = c->sim.sph.st_lambda;
+  ck.picture_range[0] = c->pic_range[0];
+  ck.picture_range[1] = c->pic_range[1];
   long pos = c->csv.f ? ftell(c->csv.f) : -1;
   ck.probes_bytes = pos > 0 ? (uint64_t)pos : 0;
   ck.nsnap = c->nsnap;
@@ -444,9 +439,16 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   snprintf(png, sizeof png, "%s/snapshot_%04d.png", c->out, c->nsnap - 1);
   const double *lo = sc->picture_box_set ? sc->picture_box_min : s->lo;
   const double *hi = sc->picture_box_set ? sc->picture_box_max : s->hi;
+  /* one colour range for the whole run: the scene's, else the first picture's whose
+   * field spans one (a fluid at rest has no velocity range yet) */
+  if (isnan(c->pic_range[0])) {
+    double r[2];
+    if (rhod_picture_field_range(&v, sc->picture_field, r) == 0 && r[0] < r[1])
+      c->pic_range[0] = r[0], c->pic_range[1] = r[1];
+  }
   st = rhod_write_picture(png, &v, sc->picture_field, sc->picture_size_panel, sc->picture_width, lo,
-                          hi, sc->picture_range_set ? sc->picture_range : NULL, sc->walls,
-                          sc->n_walls, err, len);
+                          hi, isnan(c->pic_range[0]) ? NULL : c->pic_range, sc->walls, sc->n_walls,
+                          err, len);
   return st;
 }
 
@@ -476,6 +478,8 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
   json_t *o = json_object();
   if (o) {
     json_object_set_new(o, "status", jstr(status));
+    json_object_set_new(o, "rhod_version", jstr(rhod_version()));
+    json_object_set_new(o, "git_commit", jstr(rhod_commit()));
     json_object_set_new(o, "cause", jstr(cause));
     json_object_set_new(o, "scene", jstr(c->sc->path));
     json_object_set_new(o, "particles", json_integer((json_int_t)s->p.n));
@@ -584,11 +588,25 @@ static int run(run_opts *o, const char *resume_out) {
   c.nsets = o->nsets;
   c.ck_every = o->ck_every;
   int st = rhod_scene_load(scene, o->sets, o->nsets, &c.sc, err, sizeof err);
+  /* a checkpoint interval the run could not keep (more checkpoints than snapshots allowed) */
+  if (st == RHOD_OK && o->ck_every > 0 && !(c.sc->t_end / o->ck_every <= RHOD_MAX_SNAPSHOTS)) {
+    snprintf(err, sizeof err,
+             "--checkpoint-every %g s: %.3g checkpoints to time.end = %g s, more than %g; give a "
+             "longer interval",
+             o->ck_every, c.sc->t_end / o->ck_every, c.sc->t_end, RHOD_MAX_SNAPSHOTS);
+    st = resume_out ? RHOD_ERR_CHECKPOINT : RHOD_ERR_USAGE;
+    rhod_scene_free(c.sc);
+  }
   if (st != RHOD_OK) {
     report("%s", err);
     rhod_checkpoint_free(&ck);
     return st;
   }
+  c.pic_range[0] = c.pic_range[1] = NAN;
+  if (c.sc->picture_range_set)
+    c.pic_range[0] = c.sc->picture_range[0], c.pic_range[1] = c.sc->picture_range[1];
+  else if (resume_out)
+    c.pic_range[0] = ck.picture_range[0], c.pic_range[1] = ck.picture_range[1];
   char outbuf[4096];
   if (!o->out) {
     default_out(scene, outbuf, sizeof outbuf);

@@ -500,13 +500,52 @@ typedef struct {
   int picture_off; /* output.picture: false */
 } lctx;
 
+/* Every message is one line: the control characters of the user's text it quotes (keys,
+ * values, overrides, the file's path) are written as \n, \t, \r or \xNN. */
 static void put_msg(lctx *c, const char *fmt, ...) {
   if (!c->err || !c->errlen)
     return;
+  char raw[2048];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(c->err, c->errlen, fmt, ap);
+  vsnprintf(raw, sizeof raw, fmt, ap);
   va_end(ap);
+  size_t o = 0;
+  for (const unsigned char *p = (const unsigned char *)raw; *p && o + 1 < c->errlen; p++) {
+    char esc[8] = "";
+    if (*p == '\n' || *p == '\t' || *p == '\r')
+      snprintf(esc, sizeof esc, "\\%c", *p == '\n' ? 'n' : *p == '\t' ? 't' : 'r');
+    else if (*p < 0x20 || *p == 0x7f)
+      snprintf(esc, sizeof esc, "\\x%02X", *p);
+    if (!esc[0]) {
+      c->err[o++] = (char)*p;
+      continue;
+    }
+    const size_t n = strlen(esc);
+    if (o + n >= c->errlen)
+      break;
+    memcpy(c->err + o, esc, n);
+    o += n;
+  }
+  c->err[o] = '\0';
+}
+
+/* At most CLIP_MAX bytes of user text for a message, "..." when cut (never inside a UTF-8
+ * character): a 100000-character value must not push the reason out of the message. */
+#define CLIP_MAX 80
+typedef struct {
+  char s[CLIP_MAX + 4];
+} clip_buf;
+static const char *clip(clip_buf *b, const char *s) {
+  size_t n = strlen(s);
+  if (n <= CLIP_MAX)
+    return s;
+  n = CLIP_MAX;
+  while (n > 0 && ((unsigned char)s[n] & 0xC0) == 0x80)
+    n--;
+  memcpy(b->s, s, n);
+  memcpy(b->s + n, "...", 4);
+  return b->s;
 }
 
 static const char *shown(const char *path) { return path && path[0] ? path : "(top level)"; }
@@ -515,9 +554,11 @@ static const char *shown(const char *path) { return path && path[0] ? path : "(t
  * override. Returns RHOD_ERR_SCENE. */
 static int vfail_at(lctx *c, const ry_node *n, const char *path, const char *fmt, va_list ap) {
   char reason[768];
+  clip_buf cb;
   vsnprintf(reason, sizeof reason, fmt, ap);
   if (n && n->origin >= 0 && n->origin < c->n_ov)
-    put_msg(c, "--set %s: %s: %s", c->ov[n->origin] ? c->ov[n->origin] : "", shown(path), reason);
+    put_msg(c, "--set %s: %s: %s", clip(&cb, c->ov[n->origin] ? c->ov[n->origin] : ""), shown(path),
+            reason);
   else
     put_msg(c, "%s:%u:%u: %s: %s", c->file, n ? n->line : 1u, n ? n->col : 1u, shown(path), reason);
   return RHOD_ERR_SCENE;
@@ -548,7 +589,8 @@ static int fail_ov(lctx *c, int k, const char *path, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(reason, sizeof reason, fmt, ap);
   va_end(ap);
-  put_msg(c, "--set %s: %s: %s", c->ov[k] ? c->ov[k] : "", shown(path), reason);
+  clip_buf cb;
+  put_msg(c, "--set %s: %s: %s", clip(&cb, c->ov[k] ? c->ov[k] : ""), shown(path), reason);
   return RHOD_ERR_SCENE;
 }
 
@@ -631,8 +673,9 @@ static void describe_schema(const cyaml_schema_value_t *s, char *buf, size_t len
 }
 
 static void describe_node(const ry_node *n, char *buf, size_t len) {
+  clip_buf cb;
   if (n->kind == RY_SCALAR)
-    snprintf(buf, len, "'%s'", n->text);
+    snprintf(buf, len, "'%s'", clip(&cb, n->text));
   else
     snprintf(buf, len, "%s", n->kind == RY_MAP ? "a mapping" : "a list");
 }
@@ -644,11 +687,19 @@ typedef struct {
   size_t len;
 } cy_log;
 
+/* Each logged line is cut to 256 bytes: a long value quoted in the reason must not push
+ * the backtrace's "(line: L, column: C)", which places the error, out of the log. */
 static void cy_log_fn(cyaml_log_t level, void *ctx, const char *fmt, va_list args) {
   cy_log *l = ctx;
   if (level < CYAML_LOG_ERROR || l->len + 1 >= sizeof l->text)
     return;
-  int n = vsnprintf(l->text + l->len, sizeof l->text - l->len, fmt, args);
+  char line[256];
+  int n = vsnprintf(line, sizeof line, fmt, args);
+  if (n < 0)
+    return;
+  if ((size_t)n >= sizeof line) /* cut: keep the line's end */
+    memcpy(line + sizeof line - 5, "...\n", 5);
+  n = snprintf(l->text + l->len, sizeof l->text - l->len, "%s", line);
   if (n > 0)
     l->len += (size_t)n < sizeof l->text - l->len ? (size_t)n : sizeof l->text - l->len - 1;
 }
@@ -662,6 +713,20 @@ static ry_node *find_unknown_key(ry_node *n, const char *key) {
   }
   for (unsigned i = 0; i < n->n; i++) {
     ry_node *k = find_unknown_key(n->items[i], key);
+    if (k)
+      return k;
+  }
+  return NULL;
+}
+
+/* The first key, in document order, that the schema does not know (libcyaml stops at
+ * the first one): for a key whose name the log cannot carry (a line break in it). */
+static ry_node *first_unknown_key(ry_node *n) {
+  const cyaml_schema_value_t *s = n->schema;
+  for (unsigned i = 0; i < n->n; i++) {
+    if (n->kind == RY_MAP && s && s->type == CYAML_MAPPING && !schema_field(s, n->keys[i]->text))
+      return n->keys[i];
+    ry_node *k = first_unknown_key(n->items[i]);
     if (k)
       return k;
   }
@@ -738,6 +803,8 @@ static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
     if (!k)
       k = find_unknown_key(c->root, arg);
     if (!k)
+      k = first_unknown_key(c->root);
+    if (!k)
       return fail_at(c, at, path, "unknown key '%s'", arg);
     node_path(k, path, sizeof path);
     return fail_at(c, k, path, "unknown key");
@@ -784,7 +851,8 @@ static int cyaml_failure(lctx *c, cyaml_err_t cerr, const cy_log *log) {
   describe_node(at, got, sizeof got);
   if (strncmp(reason, "Expecting ", 10) == 0)
     return fail_at(c, at, path, "expected %s, got %s", want, got);
-  const char *text = at->kind == RY_SCALAR ? at->text : arg;
+  clip_buf cb;
+  const char *text = clip(&cb, at->kind == RY_SCALAR ? at->text : arg);
   if (strncmp(reason, "Invalid FLOAT", 13) == 0)
     return fail_at(c, at, path, "invalid number '%s'", text);
   if (strncmp(reason, "FLOAT", 5) == 0)
@@ -830,18 +898,19 @@ static int check_scalars(lctx *c, const ry_node *n) {
     char path[256];
     double v;
     bool b;
+    clip_buf cb;
     if (s->type == CYAML_FLOAT) {
       if (!parse_number(n->text, &v)) {
         node_path(n, path, sizeof path);
-        return fail_at(c, n, path, "invalid number '%s'", n->text);
+        return fail_at(c, n, path, "invalid number '%s'", clip(&cb, n->text));
       }
       if (!isfinite(v)) {
         node_path(n, path, sizeof path);
-        return fail_at(c, n, path, "must be a finite number, got '%s'", n->text);
+        return fail_at(c, n, path, "must be a finite number, got '%s'", clip(&cb, n->text));
       }
     } else if (s->type == CYAML_BOOL && !parse_bool(n->text, &b)) {
       node_path(n, path, sizeof path);
-      return fail_at(c, n, path, "invalid boolean '%s' (true or false)", n->text);
+      return fail_at(c, n, path, "invalid boolean '%s' (true or false)", clip(&cb, n->text));
     }
   }
   for (unsigned i = 0; i < n->n; i++) {
@@ -854,7 +923,24 @@ static int check_scalars(lctx *c, const ry_node *n) {
 
 /* ---- `--set` overrides ------------------------------------------------------------------ */
 
+/* " (FILE:LINE:COL)" or " (from --set OVERRIDE)": where a node that an override runs
+ * into came from, for the override's message. */
+typedef struct {
+  char s[4300];
+} where_buf;
+static const char *where_from(const lctx *c, const ry_node *n, where_buf *b) {
+  clip_buf cb;
+  if (n->origin >= 0 && n->origin < c->n_ov)
+    snprintf(b->s, sizeof b->s, " (from --set %s)",
+             clip(&cb, c->ov[n->origin] ? c->ov[n->origin] : ""));
+  else
+    snprintf(b->s, sizeof b->s, " (%s:%u:%u)", c->file, n->line, n->col);
+  return b->s;
+}
+
+/* Every error here names the override (never only a line of the scene file). */
 static int apply_override(lctx *c, int k) {
+  where_buf wbuf;
   const char *ov = c->ov[k] ? c->ov[k] : "";
   const char *eq = strchr(ov, '=');
   if (!eq || eq == ov)
@@ -904,7 +990,7 @@ static int apply_override(lctx *c, int k) {
         char parent[256];
         node_path(cur, parent, sizeof parent);
         describe_node(cur, got, sizeof got);
-        rc = fail_at(c, cur, parent, "expected a mapping, got %s", got);
+        rc = fail_ov(c, k, parent, "expected a mapping, got %s%s", got, where_from(c, cur, &wbuf));
         break;
       }
       child_schema = &f->value;
@@ -934,7 +1020,7 @@ static int apply_override(lctx *c, int k) {
         char parent[256];
         node_path(cur, parent, sizeof parent);
         describe_node(cur, got, sizeof got);
-        rc = fail_at(c, cur, parent, "expected a list, got %s", got);
+        rc = fail_ov(c, k, parent, "expected a list, got %s%s", got, where_from(c, cur, &wbuf));
         break;
       }
       child_schema = s->sequence.entry;
@@ -2181,11 +2267,15 @@ int rhod_scene_load(const char *path, const char *const *overrides, int n_overri
   }
   char *text = NULL;
   size_t len = 0;
-  int e = rhod_read_file(path, &text, &len);
+  int e = rhod_read_file(path, RHOD_SCENE_MAX_BYTES, &text, &len);
   if (e) {
     if (e == ENOMEM)
       return fail_oom(&c);
-    put_msg(&c, "%s: cannot read: %s", path, strerror(e));
+    if (e == RHOD_READ_TOO_LARGE)
+      put_msg(&c, "%s: cannot read: larger than %zu MiB, the limit for a scene", path,
+              RHOD_SCENE_MAX_BYTES >> 20);
+    else
+      put_msg(&c, "%s: cannot read: %s", path, rhod_read_strerror(e));
     return RHOD_ERR_READ;
   }
   ry_error ye;

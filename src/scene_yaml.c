@@ -10,6 +10,9 @@
 #include <yaml.h>
 
 enum { RY_MAX_DEPTH = 64, RY_MAX_NODES = 1000000 };
+/* The text of all scalars (keys included) after aliases are expanded: the node cap alone
+ * lets a few lines of anchors and aliases copy one long string into gigabytes. */
+#define RY_MAX_TEXT ((size_t)64 << 20)
 
 /* ---- nodes ---------------------------------------------------------------------------- */
 
@@ -205,7 +208,7 @@ typedef struct {
   anchor *anchors;
   unsigned n_anchors, cap_anchors;
   ry_node *root;
-  size_t count;
+  size_t count, bytes; /* nodes and scalar bytes so far, aliases expanded */
   int origin, docs;
   ry_error *e;
 } builder;
@@ -235,8 +238,20 @@ static void set_oom(builder *b) {
   set_error(b, 1, 1, "out of memory");
 }
 
+/* Counts a scalar's text against RY_MAX_TEXT; 0 when it still fits. */
+static int count_text(builder *b, size_t len) {
+  if (len > RY_MAX_TEXT - b->bytes) {
+    b->bytes = RY_MAX_TEXT + 1;
+    return -1;
+  }
+  b->bytes += len;
+  return 0;
+}
+
 static ry_node *copy_tree(builder *b, const ry_node *src) {
   if (++b->count > RY_MAX_NODES)
+    return NULL;
+  if (src->kind == RY_SCALAR && count_text(b, strlen(src->text)))
     return NULL;
   ry_node *n = src->kind == RY_SCALAR ? ry_new_scalar(src->text, b->origin, src->line, src->col)
                                       : ry_new(src->kind, b->origin, src->line, src->col);
@@ -334,6 +349,15 @@ static int on_event(builder *b, const yaml_event_t *ev) {
     }
     return 0;
   case YAML_SCALAR_EVENT:
+    /* an escaped NUL ("a\0b") would silently cut the text at the NUL */
+    if (memchr(ev->data.scalar.value, '\0', ev->data.scalar.length)) {
+      set_error(b, line, col, "a NUL character (\\0) in a string");
+      return -1;
+    }
+    if (count_text(b, ev->data.scalar.length)) {
+      set_error(b, line, col, "more than %zu MiB of text", RY_MAX_TEXT >> 20);
+      return -1;
+    }
     node = ry_new(RY_SCALAR, b->origin, line, col);
     if (node) {
       node->text = malloc(ev->data.scalar.length + 1);
@@ -376,6 +400,10 @@ static int on_event(builder *b, const yaml_event_t *ev) {
     node = copy_tree(b, target);
     if (!node && b->count > RY_MAX_NODES) {
       set_error(b, line, col, "aliases expand to more than %d nodes", RY_MAX_NODES);
+      return -1;
+    }
+    if (!node && b->bytes > RY_MAX_TEXT) {
+      set_error(b, line, col, "aliases expand to more than %zu MiB of text", RY_MAX_TEXT >> 20);
       return -1;
     }
     if (node) {

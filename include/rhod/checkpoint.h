@@ -23,6 +23,8 @@ typedef struct {
   double stiffness;              /* the stiffness limit's last measure, 1/s (0 before version 3) */
   int64_t absorbed;              /* APR stragglers absorbed so far (0 before version 4) */
   double ke_merged, ke_absorbed; /* the energy coalescing took out so far (idem) */
+  double picture_range[2];       /* the pictures' colour range, fixed at the first picture that
+                                    had one (version 5); NaN, NaN: none fixed yet */
   uint64_t probes_bytes;         /* length of probes.csv when the checkpoint was taken */
   int32_t nsnap;
   double *snap_t;

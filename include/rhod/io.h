@@ -135,15 +135,31 @@ typedef struct {
 int rhod_csv_open(rhod_csv *c, const char *path, unsigned ncols, const char *const *names,
                   char *err, size_t errlen);
 /* Reopens an existing probes.csv for appending after cutting it to `bytes` (its length
- * at a checkpoint: rows written after it are dropped, the resumed run writes them again). */
+ * at a checkpoint: rows written after it are dropped, the resumed run writes them again).
+ * Never lengthens it: a file shorter than `bytes`, missing, not a regular file, whose
+ * header does not hold t and ncols columns or whose byte `bytes` does not end a row is
+ * refused with RHOD_ERR_CHECKPOINT ("path: reason"); failing writes give RHOD_ERR_IO. */
 int rhod_csv_reopen(rhod_csv *c, const char *path, unsigned ncols, uint64_t bytes, char *err,
                     size_t errlen);
+/* The same checks (but the header's column count) without changing anything: for a
+ * resume to refuse a probes.csv before it writes anything. */
+int rhod_csv_check(const char *path, uint64_t bytes, char *err, size_t errlen);
 int rhod_csv_row(rhod_csv *c, double t, const double *values, char *err, size_t errlen);
 int rhod_csv_close(rhod_csv *c, char *err, size_t errlen);
 
-/* Reads a whole file into a malloc'd buffer, NUL-terminated (len excludes the NUL).
- * Returns 0 or an errno value (ENOMEM included); *text is untouched on failure. */
-int rhod_read_file(const char *path, char **text, size_t *len);
+/* Reads a whole regular file of at most max bytes into a malloc'd buffer, NUL-terminated
+ * (len excludes the NUL). The open never blocks (a FIFO), and a device, FIFO, socket or
+ * directory is refused before anything is read. Returns 0, an errno value (ENOMEM and
+ * EISDIR included), RHOD_READ_NOT_REGULAR or RHOD_READ_TOO_LARGE (more than max bytes,
+ * also when the file grows while it is read); *text is untouched on failure. */
+#define RHOD_READ_NOT_REGULAR (-1)
+#define RHOD_READ_TOO_LARGE (-2)
+int rhod_read_file(const char *path, size_t max, char **text, size_t *len);
+/* The reason for rhod_read_file's return value e, for "path: cannot read: REASON". */
+const char *rhod_read_strerror(int e);
+/* The largest scene file (its text, before aliases are expanded) and checkpoint read. */
+#define RHOD_SCENE_MAX_BYTES ((size_t)16 << 20)
+#define RHOD_CHECKPOINT_MAX_BYTES ((uint64_t)64 << 30)
 /* Writes `text` to path through path.tmp + rename. */
 int rhod_write_file_atomic(const char *path, const char *text, char *err, size_t errlen);
 /* The same for `len` bytes of any data: path.tmp in the same folder is written, fsync'd,
