@@ -670,10 +670,11 @@ static int run(run_opts *o, const char *resume_out) {
     }
   }
   int missing = 0;
-  if (st == RHOD_OK)
-    st = prepare_output(out, resume_out != NULL, o->overwrite, &lockfd, err, sizeof err);
+  /* a resume's files checked first: a refused resume leaves the folder as it was */
   if (st == RHOD_OK && resume_out)
     st = check_resume_files(out, &ck, &missing, err, sizeof err);
+  if (st == RHOD_OK)
+    st = prepare_output(out, resume_out != NULL, o->overwrite, &lockfd, err, sizeof err);
   if (st == RHOD_OK)
     st = rhod_write_walls(out, c.sc, err, sizeof err);
   if (st != RHOD_OK) {

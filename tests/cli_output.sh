@@ -99,8 +99,8 @@ for b in bad:
 sys.exit(1 if bad else 0)
 PYEOF
 
-# the same scene without walls: no walls file, and none left from the run before
-expect 0 "run without walls" -- "$RHOD" run "$SCENE" -o "$T/out" --set 'walls=[]' \
+# the same scene without walls, replacing the run before: no walls file left
+expect 0 "run without walls" -- "$RHOD" run "$SCENE" -o "$T/out" --overwrite --set 'walls=[]' \
   --set domain.min=[0,0] --set domain.max=[0.6,0.4] --set time.end=0.001 \
   --set time.output_every=0.001
 check "no walls.h5 without walls" -- test ! -e "$T/out/walls.h5"

@@ -14,10 +14,11 @@ while [ $# -gt 0 ]; do
   *) break ;;
   esac
 done
-OUT=$(mktemp -d)
-trap 'rm -rf "$OUT"' EXIT
-if ! "$RHOD" run "$SRC/cases/$CASE/$SCENE" -o "$OUT" "$@" >"$OUT/.stdout" 2>&1; then
-  tail -5 "$OUT/.stdout"
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+OUT=$TMP/out
+if ! "$RHOD" run "$SRC/cases/$CASE/$SCENE" -o "$OUT" "$@" >"$TMP/stdout" 2>&1; then
+  tail -5 "$TMP/stdout"
   exit 1
 fi
 "${PYTHON:-/usr/bin/python3}" "$SRC/cases/$CASE/check" "$OUT" "${CHECK_ARGS[@]}"

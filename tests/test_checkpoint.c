@@ -32,6 +32,7 @@ static void base(rhod_checkpoint *ck, rhod_particles *p) {
   ck->checkpoint_every = 0.25;
   ck->step = 40, ck->reflected = 1, ck->splits = 2, ck->merges = 1, ck->absorbed = 0;
   ck->stiffness = 3.5, ck->ke_merged = 1e-6, ck->ke_absorbed = 0;
+  ck->picture_range[0] = 0, ck->picture_range[1] = 2e4;
   ck->probes_bytes = 123;
   ck->nsnap = 2, ck->snap_t = snap_t, ck->snap_n = snap_n;
   ck->scene_path = "/x/scene.yaml";
@@ -109,6 +110,8 @@ STATE_CASE(test_negative_reflected, "reflected", ck.reflected = -1)
 STATE_CASE(test_negative_merges, "merges", ck.merges = -1)
 STATE_CASE(test_nan_stiffness, "stiffness", ck.stiffness = NAN)
 STATE_CASE(test_inf_energy, "ke_merged", ck.ke_merged = -INFINITY)
+STATE_CASE(test_picture_range_reversed, "picture_range", ck.picture_range[0] = 3e4)
+STATE_CASE(test_picture_range_half, "picture_range", ck.picture_range[1] = NAN)
 STATE_CASE(test_absurd_probes_bytes, "probes_bytes", ck.probes_bytes = (uint64_t)1 << 50)
 STATE_CASE(test_zero_probes_bytes, "probes_bytes", ck.probes_bytes = 0)
 STATE_CASE(test_snapshot_after_t, "snap_t", snap_t[1] = 2.0)
@@ -150,8 +153,9 @@ static void patch(unsigned char *b, size_t len, size_t off, const void *v, size_
   memcpy(b + len - 8, &h, 8);
 }
 
-/* Offsets in a version-4 file: magic 8, version 4, precision 4, then the records. */
-enum { OFF_T = 16, OFF_NEXT_OUT = 24, OFF_PROBES_BYTES = 120, OFF_NSNAP = 128 };
+/* Offsets in a version-5 file: magic 8, version 4, precision 4, then the records
+ * (src/checkpoint.c: 13 eight-byte values, the picture range, then probes_bytes). */
+enum { OFF_T = 16, OFF_NEXT_OUT = 24, OFF_PROBES_BYTES = 136, OFF_NSNAP = 144 };
 
 static int parse_patched(size_t off, const void *v, size_t n, char *err, size_t len) {
   rhod_checkpoint ck;
@@ -225,6 +229,8 @@ int main(void) {
       {"negative merge count", test_negative_merges},
       {"NaN stiffness", test_nan_stiffness},
       {"infinite energy", test_inf_energy},
+      {"picture range reversed", test_picture_range_reversed},
+      {"picture range half unset", test_picture_range_half},
       {"absurd probes.csv length", test_absurd_probes_bytes},
       {"zero probes.csv length", test_zero_probes_bytes},
       {"snapshot after t", test_snapshot_after_t},

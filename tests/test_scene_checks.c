@@ -5,6 +5,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "cunit_main.h"
+#include "rhod/io.h"
 #include "rhod/scene.h"
 #include "rhod/sim.h"
 
@@ -87,16 +88,31 @@ static const char *TANK = "time: {end: 0.1, output_every: 0.05}\n"
 static void test_limits_edges(void) {
   char err[1024];
   rhod_scene *s = NULL;
-  /* 16384 pixels high exactly: a 1 x 20.48 domain at width 800 */
-  const char *ov[] = {"walls.0.rect.max=[0.4, 8.192]", "output.picture.width=800"};
-  CU_ASSERT_EQUAL(load_text(TANK, ov, 2, &s, err, sizeof err), RHOD_OK);
-  rhod_scene_free(s);
-  s = NULL;
-  const char *ov2[] = {"walls.0.rect.max=[0.4, 8.2]", "output.picture.width=800"};
-  CU_ASSERT_EQUAL(load_text(TANK, ov2, 2, &s, err, sizeof err), RHOD_ERR_SCENE);
-  CU_ASSERT_PTR_NOT_NULL(strstr(err, "--set output.picture.width=800: output.picture.width: "));
+  /* the loader's picture limit is the writer's: around the edge (16384 pixels a side,
+   * margins for the axes and the colour bar included), a scene loads exactly when
+   * rhod_picture_layout can lay its picture out */
+  int seen_fit = 0, seen_unfit = 0;
+  for (int k = 0; k < 40; k++) {
+    char wall[64];
+    snprintf(wall, sizeof wall, "walls.0.rect.max=[0.4, %.2f]", 7.9 + 0.01 * k);
+    const char *off[] = {wall, "output.picture=false"};
+    CU_ASSERT_EQUAL_FATAL(load_text(TANK, off, 2, &s, err, sizeof err), RHOD_OK);
+    rhod_picture_geometry g;
+    const int fits = rhod_picture_layout(800, 1, s->domain_min, s->domain_max, &g) == 0;
+    rhod_scene_free(s);
+    s = NULL;
+    const char *on[] = {wall, "output.picture.width=800"};
+    const int rc = load_text(TANK, on, 2, &s, err, sizeof err);
+    CU_ASSERT_EQUAL(rc, fits ? RHOD_OK : RHOD_ERR_SCENE);
+    if (!fits)
+      CU_ASSERT_PTR_NOT_NULL(strstr(err, "--set output.picture.width=800: output.picture.width: "));
+    rhod_scene_free(s);
+    s = NULL;
+    seen_fit |= fits, seen_unfit |= !fits;
+  }
+  CU_ASSERT(seen_fit && seen_unfit);
   /* pictures off: no limit on their size */
-  const char *ov3[] = {"walls.0.rect.max=[0.4, 8.2]", "output.picture=false"};
+  const char *ov3[] = {"walls.0.rect.max=[0.4, 8.3]", "output.picture=false"};
   CU_ASSERT_EQUAL(load_text(TANK, ov3, 2, &s, err, sizeof err), RHOD_OK);
   rhod_scene_free(s);
   /* 1e6 snapshots are allowed, not more */
