@@ -989,11 +989,11 @@ static int read_all(reader *r, rhod_snapshot_data *out) {
   return rc;
 }
 
-int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen) {
-  memset(out, 0, sizeof *out);
+/* Opens path for reading into r. A plain open first, for a clean "No such file or
+ * directory" style reason. */
+static int open_reader(reader *r, const char *path, char *err, size_t errlen) {
   h5_quiet();
-  reader r = {-1, path, err, errlen};
-  /* A plain open first, for a clean "No such file or directory" style reason. */
+  *r = (reader){-1, path, err, errlen};
   int fd = open(path, O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     set_err(err, errlen, "%s: cannot read: %s", path, strerror(errno));
@@ -1002,19 +1002,28 @@ int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, siz
   close(fd);
   hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
   if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0)
-    r.file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    r->file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
   h5_reason R = {0, 0, 0, ""};
-  if (r.file < 0)
+  if (r->file < 0)
     note(&R);
   if (fapl >= 0)
     H5Pclose(fapl);
-  if (r.file < 0) {
+  if (r->file < 0) {
     char reason[200];
     reason_text(&R, reason, sizeof reason);
     set_err(err, errlen, "%s: cannot read: %s", path, reason);
     return RHOD_ERR_READ;
   }
-  int rc = read_all(&r, out);
+  return RHOD_OK;
+}
+
+int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen) {
+  memset(out, 0, sizeof *out);
+  reader r;
+  int rc = open_reader(&r, path, err, errlen);
+  if (rc)
+    return rc;
+  rc = read_all(&r, out);
   H5Fclose(r.file);
   H5Eclear2(H5E_DEFAULT);
   if (rc)
@@ -1046,18 +1055,10 @@ void rhod_snapshot_data_free(rhod_snapshot_data *d) {
 
 int rhod_read_snapshot_header(const char *path, double *time, uint64_t *n, char *err,
                               size_t errlen) {
-  h5_quiet();
-  reader r = {-1, path, err, errlen};
-  int fd = open(path, O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    set_err(err, errlen, "%s: cannot read: %s", path, strerror(errno));
-    return RHOD_ERR_READ;
-  }
-  close(fd);
-  r.file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (r.file < 0)
-    return rfail(&r, "the file");
-  int rc = RHOD_OK;
+  reader r;
+  int rc = open_reader(&r, path, err, errlen);
+  if (rc)
+    return rc;
   hid_t h = -1;
   if (H5Lexists(r.file, "/Header", H5P_DEFAULT) <= 0) {
     set_err(err, errlen, "%s: missing group /Header", path);

@@ -101,34 +101,34 @@ static void clear_progress(void) {
   }
 }
 
-/* One line on stdout (and into run.log). */
-static void logline(const char *fmt, ...) {
-  char buf[2048], line[4096];
-  va_list ap;
-  va_start(ap, fmt);
+/* One line, control characters escaped, after clearing a live progress line. */
+static void emit(FILE *to, const char *prefix, int to_log, const char *fmt, va_list ap) {
+  char buf[4096], line[8192];
   vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
   one_line(buf, line, sizeof line);
   clear_progress();
-  printf("%s\n", line);
-  fflush(stdout);
-  if (g_log) {
+  fprintf(to, "%s%s\n", prefix, line);
+  fflush(to);
+  if (to_log && g_log) {
     fprintf(g_log, "%s\n", line);
     fflush(g_log);
   }
 }
 
-/* "rhod: message" on stderr, as one line. */
-static void report(const char *fmt, ...) {
-  char buf[4096], line[8192];
+/* A line on stdout and into run.log. */
+static void logline(const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  emit(stdout, "", 1, fmt, ap);
   va_end(ap);
-  one_line(buf, line, sizeof line);
-  clear_progress();
-  fprintf(stderr, "rhod: %s\n", line);
-  fflush(stderr);
+}
+
+/* "rhod: message" on stderr. */
+static void report(const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  emit(stderr, "rhod: ", 0, fmt, ap);
+  va_end(ap);
 }
 
 static double now(void) {

@@ -113,25 +113,10 @@ static const glyph *glyph_of(char ch) {
   return NULL;
 }
 
-/* Draws s with its top-left corner at (x, y); characters without a glyph are blanks. */
-static void draw_text(canvas *c, long x, long y, int scale, const char *s) {
-  static const unsigned char ink[3] = {0, 0, 0};
-  for (; *s; s++, x += 6 * scale) {
-    const glyph *g = glyph_of(*s);
-    if (!g)
-      continue;
-    for (int r = 0; r < 7; r++)
-      for (int col = 0; col < 5; col++)
-        if (g->rows[r] & (0x10 >> col))
-          for (int dy = 0; dy < scale; dy++)
-            for (int dx = 0; dx < scale; dx++)
-              put(c, x + col * scale + dx, y + r * scale + dy, ink);
-  }
-}
-
-/* The same turned a quarter left, read from bottom to top: the letters' tops face
- * left; (x, y) is the bottom-left corner of the turned text. */
-static void draw_text_up(canvas *c, long x, long y, int scale, const char *s) {
+/* Draws s with its top-left corner at (x, y); characters without a glyph are blanks.
+ * up: turned a quarter left, read from bottom to top (the letters' tops face left), with
+ * (x, y) the bottom-left corner of the turned text. */
+static void draw_text_turned(canvas *c, long x, long y, int scale, const char *s, int up) {
   static const unsigned char ink[3] = {0, 0, 0};
   for (long i = 0; *s; s++, i++) {
     const glyph *g = glyph_of(*s);
@@ -141,9 +126,21 @@ static void draw_text_up(canvas *c, long x, long y, int scale, const char *s) {
       for (int col = 0; col < 5; col++)
         if (g->rows[r] & (0x10 >> col))
           for (int dy = 0; dy < scale; dy++)
-            for (int dx = 0; dx < scale; dx++)
-              put(c, x + r * scale + dx, y - 1 - ((i * 6 + col) * scale + dy), ink);
+            for (int dx = 0; dx < scale; dx++) {
+              const long along = (i * 6 + col) * scale + (up ? dy : dx);
+              const long across = r * scale + (up ? dx : dy);
+              if (up)
+                put(c, x + across, y - 1 - along, ink);
+              else
+                put(c, x + along, y + across, ink);
+            }
   }
+}
+static void draw_text(canvas *c, long x, long y, int scale, const char *s) {
+  draw_text_turned(c, x, y, scale, s, 0);
+}
+static void draw_text_up(canvas *c, long x, long y, int scale, const char *s) {
+  draw_text_turned(c, x, y, scale, s, 1);
 }
 
 /* ------------------------------------------------------------ particles */

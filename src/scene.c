@@ -2418,13 +2418,7 @@ void rhod_param_list_free(rhod_param_list *p) {
 
 /* ---- warnings --------------------------------------------------------------------------- */
 
-typedef struct {
-  char *buf;
-  size_t len, used;
-  int count;
-} warn_buf;
-
-static void warn(warn_buf *w, const char *fmt, ...) {
+void rhod_warn(rhod_warn_buf *w, const char *fmt, ...) {
   if (w->buf && w->len && w->used + 1 < w->len) {
     if (w->count)
       w->used += (size_t)snprintf(w->buf + w->used, w->len - w->used, "\n");
@@ -2455,7 +2449,7 @@ static void fluid_extent(const rhod_scene *s, const double e[2], double *lo, dou
 }
 
 int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
-  warn_buf w = {buf, len, 0, 0};
+  rhod_warn_buf w = {buf, len, 0, 0};
   if (buf && len)
     buf[0] = '\0';
   if (!s)
@@ -2486,17 +2480,18 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
   double du = sqrt(2 * g * H) + umax, dp = s->rho0 * g * H;
   double bound = 10 * fmax(du, s->rho0 > 0 ? sqrt(dp / s->rho0) : 0);
   if (s->c0 < bound * (1 - 1e-12))
-    warn(&w,
-         "%s: physics.c0: %g m/s is below the bound %.4g m/s of paper 002 Eq. 2, "
-         "c0 >= 10 max(dU_max, sqrt(dP_max/rho0)), with dU_max = sqrt(2|g|H) + max|u0| = %.4g m/s, "
-         "dP_max = rho0|g|H = %.4g Pa, H = %.4g m: the flow is not weakly compressible",
-         file, s->c0, bound, du, dp, H);
+    rhod_warn(
+        &w,
+        "%s: physics.c0: %g m/s is below the bound %.4g m/s of paper 002 Eq. 2, "
+        "c0 >= 10 max(dU_max, sqrt(dP_max/rho0)), with dU_max = sqrt(2|g|H) + max|u0| = %.4g m/s, "
+        "dP_max = rho0|g|H = %.4g Pa, H = %.4g m: the flow is not weakly compressible",
+        file, s->c0, bound, du, dp, H);
 
   if (s->output_every > s->t_end)
-    warn(&w,
-         "%s: time.output_every: %g s exceeds time.end = %g s: two snapshots are written, at "
-         "t = 0 and at the end",
-         file, s->output_every, s->t_end);
+    rhod_warn(&w,
+              "%s: time.output_every: %g s exceeds time.end = %g s: two snapshots are written, at "
+              "t = 0 and at the end",
+              file, s->output_every, s->t_end);
 
   /* a free-surface level below the block's top: the particles above it start in tension */
   for (unsigned i = 0; i < s->n_fluid && g > 0; i++) {
@@ -2507,25 +2502,26 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
     double lo, hi;
     shape_extent(&b->shape, up, &lo, &hi);
     if (b->surface < hi - 1e-9 * fmax(1, fabs(hi)))
-      warn(&w,
-           "%s: fluid.%u.surface: %g m is below the block's top (%g m along -g): the particles "
-           "above it start with a negative (tensile) pressure",
-           file, i, b->surface, hi);
+      rhod_warn(
+          &w,
+          "%s: fluid.%u.surface: %g m is below the block's top (%g m along -g): the particles "
+          "above it start with a negative (tensile) pressure",
+          file, i, b->surface, hi);
   }
 
   if (s->picture_range_set && s->picture_field == RHOD_FIELD_FREE_SURFACE)
-    warn(&w, "%s: output.picture.range: ignored for field free_surface (a flag, not a scale)",
-         file);
+    rhod_warn(&w, "%s: output.picture.range: ignored for field free_surface (a flag, not a scale)",
+              file);
 
   for (int a = 0; a < 2; a++) {
     if (!s->periodic[a] || !(s->dx > 0))
       continue;
     double L = s->domain_max[a] - s->domain_min[a], n = L / s->dx;
     if (fabs(n - nearbyint(n)) > 1e-6 * fmax(1, n))
-      warn(&w,
-           "%s: domain.periodic: the domain length along %c (%g m) is not a multiple of "
-           "particles.dx (%g m): the lattice will not tile across the periodic boundary",
-           file, a ? 'y' : 'x', L, s->dx);
+      rhod_warn(&w,
+                "%s: domain.periodic: the domain length along %c (%g m) is not a multiple of "
+                "particles.dx (%g m): the lattice will not tile across the periodic boundary",
+                file, a ? 'y' : 'x', L, s->dx);
   }
   return w.count;
 }

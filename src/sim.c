@@ -885,30 +885,6 @@ void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
 
 /* ---- warnings about the particles as set up -------------------------------------------- */
 
-typedef struct {
-  char *buf;
-  size_t len, used;
-  int count;
-} sim_warn_buf;
-
-static void sim_warn(sim_warn_buf *w, const char *fmt, ...) {
-  if (w->buf && w->len && w->used + 1 < w->len) {
-    if (w->count)
-      w->used += (size_t)snprintf(w->buf + w->used, w->len - w->used, "\n");
-    if (w->used + 1 < w->len) {
-      va_list ap;
-      va_start(ap, fmt);
-      int n = vsnprintf(w->buf + w->used, w->len - w->used, fmt, ap);
-      va_end(ap);
-      if (n > 0)
-        w->used += (size_t)n;
-      if (w->used >= w->len)
-        w->used = w->len - 1;
-    }
-  }
-  w->count++;
-}
-
 /* Whether the ray from (x, y) along the unit vector d meets a wall. */
 static int wall_along(const rhod_boundary *b, double x, double y, const double d[2]) {
   for (int k = 0; k < b->nseg; k++) {
@@ -933,7 +909,7 @@ static int wall_along(const rhod_boundary *b, double x, double y, const double d
 }
 
 int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len) {
-  sim_warn_buf w = {buf, len, 0, 0};
+  rhod_warn_buf w = {buf, len, 0, 0};
   if (buf && len)
     buf[0] = '\0';
   if (!s || !s->sc)
@@ -952,8 +928,8 @@ int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len) {
     char where[512], causes[512];
     block_where(sc, b, where, sizeof where);
     block_dropped(f, causes, sizeof causes);
-    sim_warn(&w, "%s: %zu of the %zu particles of its lattice are left out: %s", where, dropped,
-             dropped + f->kept, causes);
+    rhod_warn(&w, "%s: %zu of the %zu particles of its lattice are left out: %s", where, dropped,
+              dropped + f->kept, causes);
   }
 
   /* pressure probes no fluid can reach: nothing within R at t = 0, and more than R
@@ -973,14 +949,14 @@ int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len) {
         ax < s->lo[0] - R || ax > s->hi[0] + R || ay < s->lo[1] - R || ay > s->hi[1] + R;
     const int behind = s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, ax, ay) < -R;
     if (outside || behind)
-      sim_warn(&w,
-               "%s: probes.list.%u.pressure.at: [%g, %g] lies %s, where no fluid can come: "
-               "probe %s will read 0",
-               sc->path, i, ax, ay,
-               outside ? "outside the domain"
-                       : "behind a wall (inside an obstacle or outside "
-                         "every container)",
-               pr->name);
+      rhod_warn(&w,
+                "%s: probes.list.%u.pressure.at: [%g, %g] lies %s, where no fluid can come: "
+                "probe %s will read 0",
+                sc->path, i, ax, ay,
+                outside ? "outside the domain"
+                        : "behind a wall (inside an obstacle or outside "
+                          "every container)",
+                pr->name);
   }
 
   /* gravity with nothing below: the fall along the non-periodic axes (a periodic axis
@@ -993,11 +969,11 @@ int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len) {
     for (size_t k = 0; k < n; k++)
       falling += !wall_along(&s->bnd, p->x[k], p->y[k], d);
     if (falling)
-      sim_warn(&w,
-               "%s: physics.gravity: %zu of the %zu fluid particles have no wall below them "
-               "(along gravity, outside the periodic axes): they will leave the domain, and the "
-               "run then stops as unstable",
-               sc->path, falling, n);
+      rhod_warn(&w,
+                "%s: physics.gravity: %zu of the %zu fluid particles have no wall below them "
+                "(along gravity, outside the periodic axes): they will leave the domain, and the "
+                "run then stops as unstable",
+                sc->path, falling, n);
   }
   return w.count;
 }

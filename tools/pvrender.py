@@ -1,7 +1,7 @@
 #!/usr/bin/env pvpython
 """Renders the last step of a rhod run with ParaView, as a check that ParaView reads it.
 
-    pvpython tools/pvrender.py OUT [PICTURE.png] [--field Pressure]
+    pvpython tools/pvrender.py OUT [PICTURE.png] [--field Pressure] [--representation default]
 
 Opens OUT/snapshots.xdmf (the particles, one vertex cell each, through ParaView's XDMF
 reader) and OUT/walls.xdmf (the walls as line segments, when the scene has walls), goes
@@ -25,6 +25,9 @@ def main():
     ap.add_argument("png", nargs="?", help="picture to write (default OUT/paraview.png)")
     ap.add_argument("--field", default="Pressure", help="node attribute to colour by")
     ap.add_argument("--size", default="1200,800", help="picture size in pixels, W,H")
+    ap.add_argument("--representation", default="Point Gaussian",
+                    help="ParaView representation of the particles; 'default' keeps the one "
+                    "ParaView picks when a user opens the file (Surface: a pixel per particle)")
     a = ap.parse_args()
     png = a.png or os.path.join(a.out, "paraview.png")
     xdmf = os.path.join(a.out, "snapshots.xdmf")
@@ -45,7 +48,8 @@ def main():
     view.OrientationAxesVisibility = 0
     view.Background = [1, 1, 1]
     disp = pv.Show(parts, view)
-    disp.SetRepresentationType("Point Gaussian")
+    if a.representation != "default":
+        disp.SetRepresentationType(a.representation)
     pv.ColorBy(disp, ("POINTS", a.field))
     disp.RescaleTransferFunctionToDataRange(True, False)
     disp.SetScalarBarVisibility(view, True)

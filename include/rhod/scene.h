@@ -286,6 +286,15 @@ void rhod_param_list_free(rhod_param_list *p);
  * one line each, written to buf separated by '\n'. Returns how many. */
 int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len);
 
+/* Warning lines gathered into a caller's buffer (rhod_scene_warnings, rhod_sim_warnings):
+ * each call appends one line (newline-separated, cut at the buffer's end) and counts it. */
+typedef struct {
+  char *buf;
+  size_t len, used;
+  int count;
+} rhod_warn_buf;
+void rhod_warn(rhod_warn_buf *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
 /* Limits the loader enforces on what a run would write or hold (docs/choices.md "load-time
  * limits"): the picture's sides, the snapshots and probe rows a run writes, the steps
  * that t_end needs at the largest dt Eq. 11 allows, and the initial particle count. */
