@@ -144,6 +144,24 @@ expect 3 "scene name with a newline" -- "$RHOD" run "$T/a
 b.yaml" -o "$T/nl"
 check "one-line error" -- test "$(wc -l <"$T/stderr")" -eq 1
 
+# 53.6 on a terminal the live progress line and the log lines never share a line
+if command -v script >/dev/null 2>&1; then
+  script -qec "$(printf '%q ' "$RHOD" run "$SRC/cases/dam_break/scene.yaml" -o "$T/tty" \
+    --set particles.dx=0.00584 --set time.end=0.3 --set time.output_every=0.03)" /dev/null \
+    >"$T/tty.log" 2>&1
+  check "terminal: progress shown, and cleared before every log line" -- /usr/bin/python3 - "$T/tty.log" <<'PY'
+import sys
+t = open(sys.argv[1], "rb").read().decode(errors="replace")
+shown = bad = 0
+for line in t.split("\n"):
+    line = line.rstrip("\r")
+    vis = line.split("\r")[-1]  # what stays on the terminal's line
+    shown += "particle-steps/s" in line
+    bad += "particle-steps/s" in vis and "rhod:" in vis
+sys.exit(0 if shown and not bad else f"{shown} progress lines, {bad} shared with a log line")
+PY
+fi
+
 # summary.json is valid JSON whatever the scene's path holds
 mkdir -p "$T/q\"uo\\te"; cp "$SCENE" "$T/q\"uo\\te/s\"c\\n.yaml"
 expect 0 "scene path with quotes and backslashes" -- "$RHOD" run "$T/q\"uo\\te/s\"c\\n.yaml" -o "$T/js" "${SHORT[@]}"
