@@ -478,6 +478,14 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     st = rhod_rk_watch(&s->rk, p, &p->uy, 1 / h->c0);
   if (st == RHOD_OK && h->stlim)
     st = rhod_rk_watch(&s->rk, p, &p->rho, 1 / h->rho0);
+  if (st == RHOD_ERR_SCENE) {
+    /* the stiffness limit's weights 1/c0 and 1/rho0 (rhod_rk_watch) */
+    snprintf(err, errlen,
+             "%s: physics.c0 = %g m/s, physics.rho0 = %g kg/m^3: 1/c0 or 1/rho0 is not a finite "
+             "number in %s precision",
+             sc->path, sc->c0, sc->rho0, RHOD_REAL_NAME);
+    return st;
+  }
   if (st != RHOD_OK) {
     snprintf(err, errlen, "out of memory setting up the scheme");
     return st;
