@@ -6,6 +6,7 @@
 
 #include "cunit_main.h"
 #include "rhod/io.h"
+#include "test_io_util.h"
 
 #include <errno.h>
 #include <ftw.h>
@@ -20,58 +21,13 @@
 #include <time.h>
 #include <unistd.h>
 
-static char scratch[4096];
-
-static char *spath(const char *name) {
-  static char buf[8][4200];
-  static int k;
-  char *b = buf[k++ % 8];
-  snprintf(b, sizeof buf[0], "%s/%s", scratch, name);
-  return b;
-}
-
 static int exists(const char *path) { return access(path, F_OK) == 0; }
-
-static char *slurp(const char *path, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f)
-    return NULL;
-  size_t cap = 4096, n = 0;
-  char *s = malloc(cap + 1);
-  size_t r;
-  while (s && (r = fread(s + n, 1, cap - n, f)) > 0) {
-    n += r;
-    if (n == cap) {
-      char *t = realloc(s, 2 * cap + 1);
-      if (!t) {
-        free(s);
-        s = NULL;
-        break;
-      }
-      s = t;
-      cap *= 2;
-    }
-  }
-  fclose(f);
-  if (s)
-    s[n] = '\0';
-  if (len)
-    *len = n;
-  return s;
-}
 
 static void put_file(const char *path, const char *text) {
   FILE *f = fopen(path, "w");
   CU_ASSERT_PTR_NOT_NULL_FATAL(f);
   fputs(text, f);
   fclose(f);
-}
-
-static int count_of(const char *hay, const char *needle) {
-  int n = 0;
-  for (const char *p = strstr(hay, needle); p; p = strstr(p + 1, needle))
-    n++;
-  return n;
 }
 
 /* RLIMIT_FSIZE makes write() fail with EFBIG past the limit (SIGXFSZ is ignored). */
@@ -87,21 +43,8 @@ static void unlimit_fsize(void) { setrlimit(RLIMIT_FSIZE, &saved_fsize); }
 
 /* ------------------------------------------------------------ particle data */
 
-typedef struct {
-  size_t n;
-  real *x, *y, *ux, *uy, *rho, *p, *m, *size;
-  uint64_t *id;
-  uint8_t *fs;
-} particles;
-
 static particles make_particles(size_t n) {
-  particles P = {n, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
-  size_t nn = n ? n : 1;
-  real **arrays[] = {&P.x, &P.y, &P.ux, &P.uy, &P.rho, &P.p, &P.m, &P.size};
-  for (size_t k = 0; k < 8; k++)
-    *arrays[k] = calloc(nn, sizeof(real));
-  P.id = calloc(nn, sizeof *P.id);
-  P.fs = calloc(nn, 1);
+  particles P = alloc_particles(n);
   /* exactly representable in float, so that single builds compare exactly */
   for (size_t i = 0; i < n; i++) {
     P.x[i] = (real)(0.25 * (double)i);
@@ -116,20 +59,6 @@ static particles make_particles(size_t n) {
     P.fs[i] = (uint8_t)(i % 2);
   }
   return P;
-}
-
-static void free_particles(particles *P) {
-  real *arrays[] = {P->x, P->y, P->ux, P->uy, P->rho, P->p, P->m, P->size};
-  for (size_t k = 0; k < 8; k++)
-    free(arrays[k]);
-  free(P->id);
-  free(P->fs);
-}
-
-static rhod_snapshot_view view_of(const particles *P, double t) {
-  rhod_snapshot_view v = {t,      P->n, P->x, P->y,    P->ux, P->uy,
-                          P->rho, P->p, P->m, P->size, P->id, P->fs};
-  return v;
 }
 
 /* ------------------------------------------------------------ snapshots */
@@ -436,30 +365,6 @@ static void test_xdmf(void) {
 }
 
 /* ------------------------------------------------------------ PNG */
-
-typedef struct {
-  unsigned w, h;
-  unsigned char *px;
-} rgb_image;
-
-static int read_png(const char *path, rgb_image *im) {
-  png_image img;
-  memset(&img, 0, sizeof img);
-  img.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&img, path))
-    return 0;
-  img.format = PNG_FORMAT_RGB;
-  im->w = img.width;
-  im->h = img.height;
-  im->px = malloc(PNG_IMAGE_SIZE(img));
-  if (!im->px || !png_image_finish_read(&img, NULL, im->px, 0, NULL)) {
-    png_image_free(&img);
-    free(im->px);
-    im->px = NULL;
-    return 0;
-  }
-  return 1;
-}
 
 static int pixel_is(const rgb_image *im, unsigned x, unsigned y, int r, int g, int b) {
   const unsigned char *p = im->px + 3 * ((size_t)y * im->w + x);
@@ -772,13 +677,6 @@ static void test_csv(void) {
 }
 
 /* ------------------------------------------------------------ main */
-
-static int rm_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw) {
-  (void)st;
-  (void)flag;
-  (void)ftw;
-  return remove(path);
-}
 
 int main(void) {
   signal(SIGXFSZ, SIG_IGN);

@@ -6,6 +6,7 @@
 #include "cunit_main.h"
 #include "rhod/io.h"
 #include "rhod/version.h"
+#include "test_io_util.h"
 
 #include <ftw.h>
 #include <hdf5.h>
@@ -15,59 +16,10 @@
 #include <string.h>
 #include <unistd.h>
 
-static char scratch[4096];
-
-static char *spath(const char *name) {
-  static char buf[8][4200];
-  static int k;
-  char *b = buf[k++ % 8];
-  snprintf(b, sizeof buf[0], "%s/%s", scratch, name);
-  return b;
-}
-
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f)
-    return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
-    free(s);
-    s = NULL;
-  }
-  if (s)
-    s[n] = 0;
-  fclose(f);
-  return s;
-}
-
-static int count_of(const char *hay, const char *needle) {
-  int n = 0;
-  for (const char *p = strstr(hay, needle); p; p = strstr(p + 1, needle))
-    n++;
-  return n;
-}
-
 /* ------------------------------------------------------------ particles */
 
-typedef struct {
-  size_t n;
-  real *x, *y, *ux, *uy, *rho, *p, *m, *size;
-  uint64_t *id;
-  uint8_t *fs;
-} particles;
-
 static particles make_particles(size_t n) {
-  particles P;
-  P.n = n;
-  size_t nn = n ? n : 1;
-  real **arrays[] = {&P.x, &P.y, &P.ux, &P.uy, &P.rho, &P.p, &P.m, &P.size};
-  for (size_t k = 0; k < 8; k++)
-    *arrays[k] = calloc(nn, sizeof(real));
-  P.id = calloc(nn, sizeof *P.id);
-  P.fs = calloc(nn, 1);
+  particles P = alloc_particles(n);
   for (size_t i = 0; i < n; i++) {
     P.x[i] = (real)(0.1 + 0.01 * (double)(i % 50));
     P.y[i] = (real)(0.1 + 0.01 * (double)(i / 50));
@@ -81,20 +33,6 @@ static particles make_particles(size_t n) {
     P.fs[i] = (uint8_t)(i % 5 == 0);
   }
   return P;
-}
-
-static void free_particles(particles *P) {
-  real *arrays[] = {P->x, P->y, P->ux, P->uy, P->rho, P->p, P->m, P->size};
-  for (size_t k = 0; k < 8; k++)
-    free(arrays[k]);
-  free(P->id);
-  free(P->fs);
-}
-
-static rhod_snapshot_view view_of(const particles *P, double t) {
-  rhod_snapshot_view v = {t,      P->n, P->x, P->y,    P->ux, P->uy,
-                          P->rho, P->p, P->m, P->size, P->id, P->fs};
-  return v;
 }
 
 /* ------------------------------------------------------------ HDF5 helpers */
@@ -288,7 +226,7 @@ static void test_xdmf_fields(void) {
   char err[512] = "";
   CU_ASSERT_EQUAL_FATAL(
       rhod_write_xdmf(scratch, 2, times, np, RHOD_FIELDS_FREE_SURFACE, err, sizeof err), RHOD_OK);
-  char *s = slurp(spath("snapshots.xdmf"));
+  char *s = slurp(spath("snapshots.xdmf"), NULL);
   CU_ASSERT_PTR_NOT_NULL_FATAL(s);
   CU_ASSERT_PTR_NOT_NULL(strstr(s, "<Xdmf Version=\"3.0\""));
   CU_ASSERT_EQUAL(count_of(s, "Name=\"FreeSurface\""), 2);
@@ -302,7 +240,7 @@ static void test_xdmf_fields(void) {
   free(s);
   /* without the flag: no FreeSurface */
   CU_ASSERT_EQUAL_FATAL(rhod_write_xdmf(scratch, 2, times, np, 0, err, sizeof err), RHOD_OK);
-  s = slurp(spath("snapshots.xdmf"));
+  s = slurp(spath("snapshots.xdmf"), NULL);
   CU_ASSERT_PTR_NOT_NULL_FATAL(s);
   CU_ASSERT_EQUAL(count_of(s, "FreeSurface"), 0);
   free(s);
@@ -395,7 +333,7 @@ static void test_walls_file(void) {
   CU_ASSERT_EQUAL(uw.datasets, 4);
   CU_ASSERT_EQUAL(uw.with_units, 4);
   H5Fclose(f);
-  char *x = slurp(spath("walls.xdmf"));
+  char *x = slurp(spath("walls.xdmf"), NULL);
   CU_ASSERT_PTR_NOT_NULL_FATAL(x);
   CU_ASSERT_PTR_NOT_NULL(strstr(x, "TopologyType=\"Polyline\" NumberOfElements=\"260\" "
                                    "NodesPerElement=\"2\""));
@@ -416,30 +354,6 @@ static void test_walls_file(void) {
 }
 
 /* ------------------------------------------------------------ pictures */
-
-typedef struct {
-  unsigned w, h;
-  unsigned char *px;
-} rgb_image;
-
-static int read_png(const char *path, rgb_image *im) {
-  png_image img;
-  memset(&img, 0, sizeof img);
-  img.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&img, path))
-    return 0;
-  img.format = PNG_FORMAT_RGB;
-  im->w = img.width;
-  im->h = img.height;
-  im->px = malloc(PNG_IMAGE_SIZE(img));
-  if (!im->px || !png_image_finish_read(&img, NULL, im->px, 0, NULL)) {
-    png_image_free(&img);
-    free(im->px);
-    im->px = NULL;
-    return 0;
-  }
-  return 1;
-}
 
 static const unsigned char *pix(const rgb_image *im, unsigned x, unsigned y) {
   return im->px + 3 * ((size_t)y * im->w + x);
@@ -558,13 +472,6 @@ static void test_field_range(void) {
   CU_ASSERT_EQUAL(rhod_picture_field_range(&v, RHOD_FIELD_PRESSURE, r), -1);
   CU_ASSERT(r[0] == 0 && r[1] == 0);
   free_particles(&P);
-}
-
-static int rm_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw) {
-  (void)sb;
-  (void)flag;
-  (void)ftw;
-  return remove(path);
 }
 
 /* A snapshot of an earlier version, with /Parameters as attributes only: read in order. */
