@@ -686,6 +686,9 @@ static int run(run_opts *o, const char *resume_out) {
       close(lockfd);
     return st;
   }
+  /* from the first file written on, SIGINT and SIGTERM end with a checkpoint */
+  g_stop = 0;
+  install_signals();
   rhod_scene_params(c.sc, &c.params);
   c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, RHOD_PROBE_COLUMNS_TOTAL);
   c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
@@ -783,8 +786,6 @@ static int run(run_opts *o, const char *resume_out) {
       c.snap_t[i] = ck.snap_t[i], c.snap_n[i] = (size_t)ck.snap_n[i];
     c.nsnap = ck.nsnap;
   }
-  g_stop = 0;
-  install_signals();
   double last_progress = -1;
   int last_decile = -1;
   for (;;) {
