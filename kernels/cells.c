@@ -2,7 +2,7 @@
  * particles live (device or host). */
 #include "rhod/cells.h"
 #include "rhod/device.h"
-#include "rhod/scene.h"
+#include "rhod/status.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -11,8 +11,8 @@
  *
  * usage: bench_mixed SCENE [repeats=20] [key=value ...]   (key=value as --set) */
 #include "bench_common.h"
-#include "kernel.h"
-#include "rhod/sph.h"
+#include "rhod/kernel.h"
+#include "rhod/rhodsph/sph.h"
 
 /* Times pass A and pass C (reps calls each); returns us per particle per call. */
 static void time_passes(rhod_sim *s, int reps, double *ua, double *uc) {

@@ -2,7 +2,7 @@
  * and real neighbour pairs per second for the gathers.
  * usage: bench_passes [N=1e5] [repeats=10] [box|patch] [switches as bench_step] */
 #include "bench_common.h"
-#include "kernel.h"
+#include "rhod/kernel.h"
 
 int main(int argc, char **argv) {
   const double N = argc > 1 ? atof(argv[1]) : 1e5;

@@ -2,7 +2,6 @@
  * RK4 y_{n+1} = y_n + dt/6 (k1 + 2 k2 + 2 k3 + k4), stages at y_n + (dt/2, dt/2, dt) k;
  * RK2 (Heun) y_{n+1} = y_n + dt/2 (k1 + k2), k2 at y_n + dt k1. */
 #include "rhod/integrator.h"
-#include "rhod/scene.h"
 #include <math.h>
 #include <string.h>
 

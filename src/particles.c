@@ -1,7 +1,7 @@
 /* Particle store: allocation, device mapping, growth and reordering. */
 #include "rhod/particles.h"
 #include "rhod/device.h"
-#include "rhod/scene.h"
+#include "rhod/status.h"
 #include <stdlib.h>
 #include <string.h>
 

@@ -1,7 +1,7 @@
 /* Simulation set-up, stepping, checks and probes. */
 #define _DEFAULT_SOURCE /* sysconf(_SC_PHYS_PAGES) */
 #include "rhod/sim.h"
-#include "kernel.h"
+#include "rhod/kernel.h"
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>

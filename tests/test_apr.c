@@ -5,13 +5,13 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "cunit_main.h"
-#include "kernel.h"
-#include "rhod/apr.h"
+#include "rhod/kernel.h"
+#include "rhod/rhodsph/apr.h"
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/device.h"
 #include "rhod/sim.h"
-#include "rhod/sph.h"
+#include "rhod/rhodsph/sph.h"
 #include "test_scene_util.h"
 #include <math.h>
 #include <stdio.h>

@@ -1,12 +1,12 @@
 /* Engine and scheme kernels: run in the host build and in the offload build. */
 #include "cunit_main.h"
-#include "kernel.h"
+#include "rhod/kernel.h"
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/integrator.h"
 #include "rhod/sim.h"
-#include "rhod/sph.h"
-#include "sph_pair.h"
+#include "rhod/rhodsph/sph.h"
+#include "rhodsph/sph_pair.h"
 #include "test_scene_util.h"
 #include <math.h>
 #include <omp.h>

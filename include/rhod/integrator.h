@@ -9,8 +9,9 @@
 #ifndef RHOD_INTEGRATOR_H
 #define RHOD_INTEGRATOR_H
 
+#include "rhod/integrator_kind.h"
 #include "rhod/particles.h"
-#include "rhod/scene.h"
+#include "rhod/status.h"
 
 #define RHOD_RK_MAX_VARS 8
 

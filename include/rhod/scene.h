@@ -3,21 +3,10 @@
 #ifndef RHOD_SCENE_H
 #define RHOD_SCENE_H
 
+#include "rhod/integrator_kind.h"
+#include "rhod/kernel_kind.h"
+#include "rhod/status.h"
 #include <stddef.h>
-
-/* Exit codes, one per class of failure (documented in docs/scene.md and the README). */
-enum rhod_status {
-  RHOD_OK = 0,
-  RHOD_ERR_USAGE = 2,       /* bad command line */
-  RHOD_ERR_READ = 3,        /* scene file missing or unreadable */
-  RHOD_ERR_SCENE = 4,       /* scene malformed: syntax, unknown key, wrong type, bad value */
-  RHOD_ERR_OUTPUT = 5,      /* output folder cannot be created or written */
-  RHOD_ERR_UNSTABLE = 6,    /* the run went unstable: NaN/inf or a particle left the domain */
-  RHOD_ERR_IO = 7,          /* an output file could not be written during the run */
-  RHOD_ERR_MEMORY = 8,      /* allocation failed */
-  RHOD_ERR_INTERRUPTED = 9, /* stopped by SIGINT/SIGTERM after writing a checkpoint */
-  RHOD_ERR_CHECKPOINT = 10, /* a checkpoint is missing, corrupt or does not fit the scene */
-};
 
 typedef enum { RHOD_SHAPE_RECT = 0, RHOD_SHAPE_POLYGON, RHOD_SHAPE_CIRCLE } rhod_shape_kind;
 
@@ -92,18 +81,6 @@ typedef struct {
   double at[2];        /* PRESSURE: the point; ANGULAR_MOMENTUM, TORQUE_BUDGET: the origin */
   double direction[2]; /* FRONT: unit direction, default [1, 0] */
 } rhod_probe;
-
-typedef enum {
-  RHOD_KERNEL_WENDLAND_C2 = 0,
-  RHOD_KERNEL_WENDLAND_C4,
-  RHOD_KERNEL_QUINTIC
-} rhod_kernel_kind;
-
-/* time.integrator: the explicit Runge-Kutta method of the step (integrator.h) */
-typedef enum {
-  RHOD_INTEGRATOR_RK4 = 0, /* classical, 4 right-hand sides per step (paper 002 Sec. IV A) */
-  RHOD_INTEGRATOR_RK2      /* Heun (SSP-RK2), 2 right-hand sides per step: our option */
-} rhod_integrator_kind;
 
 typedef enum {
   RHOD_FIELD_PRESSURE = 0,

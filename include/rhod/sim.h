@@ -3,14 +3,14 @@
 #ifndef RHOD_SIM_H
 #define RHOD_SIM_H
 
-#include "rhod/apr.h"
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/integrator.h"
 #include "rhod/io.h"
 #include "rhod/particles.h"
+#include "rhod/rhodsph/apr.h"
+#include "rhod/rhodsph/sph.h"
 #include "rhod/scene.h"
-#include "rhod/sph.h"
 
 /* Steps between two searches for coalescing groups (refinement.coalesce). */
 #define RHOD_COALESCE_EVERY 10

@@ -2,9 +2,9 @@
  * Every pass is a gather: it writes only particle i's own entries. Conventions:
  * n_ij = (x_j - x_i)/r, grad_i W_ij = -W'(r; R_i) n_ij = F n_ij with F >= 0, and
  * W taken with the radius of the gathering particle i. */
-#include "kernel.h"
-#include "rhod/sph.h"
-#include "sph_pair.h"
+#include "rhod/kernel.h"
+#include "rhod/rhodsph/sph.h"
+#include "rhodsph/sph_pair.h"
 #include <float.h>
 #include <math.h>
 #include <string.h>

@@ -8,7 +8,7 @@
 #define RHOD_KERNEL_H
 
 #include "rhod/config.h"
-#include "rhod/scene.h"
+#include "rhod/kernel_kind.h"
 #include <math.h>
 
 #define RHOD_PI 3.14159265358979323846
