@@ -1,19 +1,36 @@
-/* Explicit Runge-Kutta over registered state arrays (integrator.h):
+/* Explicit Runge-Kutta over registered state arrays (integrator.h), each method a stage
+ * table (rhod_rk_table):
  * RK4 y_{n+1} = y_n + dt/6 (k1 + 2 k2 + 2 k3 + k4), stages at y_n + (dt/2, dt/2, dt) k;
- * RK2 (Heun) y_{n+1} = y_n + dt/2 (k1 + k2), k2 at y_n + dt k1. */
+ * RK2 (Heun) y_{n+1} = y_n + dt/2 (k1 + k2), k2 at y_n + dt k1;
+ * midpoint y_{n+1} = y_n + dt k2, k2 at y_n + dt/2 k1 (paper 000 Eqs. 9-10, paper 001
+ * Eq. 13: the explicit form of the "modified velocity Verlet" paper 000 uses). */
 #include "rhod/integrator.h"
 #include <math.h>
 #include <string.h>
 
-/* Butcher weights (times their divisor) and the next stage's fraction of dt */
-static const real rk4_w[4] = {1, 2, 2, 1}, rk4_c[4] = {0.5, 0.5, 1, 0};
-static const real rk2_w[2] = {1, 1}, rk2_c[2] = {1, 0};
+/* The stage tables: Butcher weights (times their divisor) and the next stage's fraction
+ * of dt, by rhod_integrator_kind. */
+static const rhod_rk_table tables[] = {
+    [RHOD_INTEGRATOR_RK4] = {4, 6, {1, 2, 2, 1}, {0.5, 0.5, 1, 0}},
+    [RHOD_INTEGRATOR_RK2] = {2, 2, {1, 1}, {1, 0}},
+    [RHOD_INTEGRATOR_MIDPOINT] = {2, 1, {0, 1}, {0.5, 0}},
+};
+
+const rhod_rk_table *rhod_rk_table_of(rhod_integrator_kind method) {
+  if ((unsigned)method >= sizeof tables / sizeof tables[0])
+    return NULL;
+  return &tables[method];
+}
 
 int rhod_rk_init(rhod_rk *rk, rhod_particles *p, rhod_integrator_kind method) {
   (void)p;
   memset(rk, 0, sizeof *rk);
+  const rhod_rk_table *t = rhod_rk_table_of(method);
+  if (!t)
+    return RHOD_ERR_SCENE;
   rk->method = method;
-  rk->stages = method == RHOD_INTEGRATOR_RK2 ? 2 : 4;
+  rk->table = *t;
+  rk->stages = t->stages;
   return RHOD_OK;
 }
 
@@ -93,10 +110,9 @@ void rhod_rk_begin(rhod_rk *rk, const rhod_particles *p) {
 }
 
 void rhod_rk_stage(rhod_rk *rk, const rhod_particles *p, int s, real dt) {
-  const int rk2 = rk->method == RHOD_INTEGRATOR_RK2;
-  const real *w = rk2 ? rk2_w : rk4_w, *c = rk2 ? rk2_c : rk4_c;
+  const rhod_rk_table *t = &rk->table;
   const long n = (long)p->n;
-  const real ws = w[s], cs = c[s] * dt, d6 = dt / (rk2 ? 2 : 6);
+  const real ws = t->w[s], cs = t->c[s] * dt, d6 = dt / t->div;
   const int last = s == rk->stages - 1;
   for (int v = 0; v < rk->nvars; v++) {
     real *y = *rk->state[v];
@@ -104,7 +120,7 @@ void rhod_rk_stage(rhod_rk *rk, const rhod_particles *p, int s, real dt) {
     real *y0 = rk->y0[v], *sum = rk->sum[v];
     const int st = rk->stride[v], of = rk->offset[v];
     /* the stiffness measure keeps k2 - k1; at stage 1 the sum holds k1 */
-    real *d21 = s == 1 && !rk2 && rk->watch[v] > 0 ? rk->d21[v] : NULL;
+    real *d21 = s == 1 && rk->method == RHOD_INTEGRATOR_RK4 && rk->watch[v] > 0 ? rk->d21[v] : NULL;
     RHOD_KERNEL_LOOP
     for (long i = 0; i < n; i++) {
       const real k = d[st * i + of];

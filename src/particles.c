@@ -79,6 +79,17 @@ int rhod_particles_init(rhod_particles *p, size_t cap) {
   return alloc_scratch(p);
 }
 
+int rhod_particles_add_tags(rhod_particles *p) {
+  int st = RHOD_OK;
+  if (!p->phase)
+    st = rhod_particles_add_field(p, "phase", (void **)&p->phase, 1, 1);
+  if (st == RHOD_OK && !p->kind)
+    st = rhod_particles_add_field(p, "kind", (void **)&p->kind, 1, 1);
+  if (st == RHOD_OK && !p->level)
+    st = rhod_particles_add_field(p, "level", (void **)&p->level, 1, 1);
+  return st;
+}
+
 int rhod_particles_reserve(rhod_particles *p, size_t cap) {
   if (cap <= p->cap)
     return RHOD_OK;

@@ -1,11 +1,11 @@
 /* Engine and scheme kernels: run in the host build and in the offload build. */
 #include "cunit_main.h"
-#include "rhod/kernel.h"
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/integrator.h"
-#include "rhod/sim.h"
+#include "rhod/kernel.h"
 #include "rhod/rhodsph/sph.h"
+#include "rhod/sim.h"
 #include "rhodsph/sph_pair.h"
 #include "test_scene_util.h"
 #include <math.h>
@@ -1163,8 +1163,10 @@ static void test_walls_guard(void) {
   free(sc);
 }
 
-/* RK4 and RK2 on dx/dt = -x, dy/dt = x: error ratio for halved dt near 2^4 and 2^2. */
-static double rk_error(rhod_integrator_kind method, int nsteps) {
+/* RK4, RK2 and midpoint on dx/dt = -x, dy/dt = x (nonlinear: dx/dt = -x^2, x = 1/(1 + t),
+ * y = ln(1 + t)) to t = 2: error ratio for halved dt near 2^4 and 2^2. With `first` the
+ * x after one step instead of the error. */
+static double rk_run(rhod_integrator_kind method, int nsteps, int nonlinear, int first) {
   rhod_particles p;
   rhod_particles_init(&p, 4);
   p.n = 1;
@@ -1183,17 +1185,45 @@ static double rk_error(rhod_integrator_kind method, int nsteps) {
     for (int st = 0; st < rk.stages; st++) {
       rhod_to_host(p.x, sizeof(real));
       rhod_to_host(p.y, sizeof(real));
-      d[0] = -p.x[0]; /* x' = -x */
-      d[1] = p.x[0];  /* y' = x */
+      d[0] = nonlinear ? -p.x[0] * p.x[0] : -p.x[0]; /* x' = -x or -x^2 */
+      d[1] = p.x[0];                                 /* y' = x */
       rhod_to_device(d, 2 * sizeof(real));
       rhod_rk_stage(&rk, &p, st, dt);
     }
+    if (first)
+      break;
   }
   rhod_to_host(p.x, sizeof(real));
   rhod_to_host(p.y, sizeof(real));
-  const double err = fabs(p.x[0] - exp(-2.0)) + fabs(p.y[0] - (1 - exp(-2.0)));
+  const double err = first       ? p.x[0]
+                     : nonlinear ? fabs(p.x[0] - 1 / 3.0) + fabs(p.y[0] - log(3.0))
+                                 : fabs(p.x[0] - exp(-2.0)) + fabs(p.y[0] - (1 - exp(-2.0)));
   rhod_particles_free(&p);
   return err;
+}
+static double rk_error(rhod_integrator_kind method, int nsteps) {
+  return rk_run(method, nsteps, 0, 0);
+}
+
+/* The midpoint rule (paper 000 Eqs. 9-10): one step of x' = -x^2 from 1 gives
+ * 1 - h (1 - h/2)^2 exactly (Heun: 1 - h/2 (1 + (1 - h)^2)); second order on the
+ * nonlinear problem, where it differs from Heun. An unknown method is refused. */
+static void test_rk_midpoint(void) {
+  const double h = 0.2;
+  CU_ASSERT_DOUBLE_EQUAL(rk_run(RHOD_INTEGRATOR_MIDPOINT, 10, 1, 1),
+                         1 - h * (1 - h / 2) * (1 - h / 2), 1e-6);
+  CU_ASSERT_DOUBLE_EQUAL(rk_run(RHOD_INTEGRATOR_RK2, 10, 1, 1), 1 - h / 2 * (1 + (1 - h) * (1 - h)),
+                         1e-6);
+  const double ea = rk_run(RHOD_INTEGRATOR_MIDPOINT, 20, 1, 0);
+  const double eb = rk_run(RHOD_INTEGRATOR_MIDPOINT, 40, 1, 0);
+  const double order = log2(ea / eb);
+  CU_ASSERT(order > 1.8 && order < 2.3);
+  CU_ASSERT(eb < 1e-3);
+  rhod_particles p;
+  rhod_particles_init(&p, 4);
+  rhod_rk rk;
+  CU_ASSERT_EQUAL(rhod_rk_init(&rk, &p, (rhod_integrator_kind)99), RHOD_ERR_SCENE);
+  rhod_particles_free(&p);
 }
 
 static void test_rk_order(void) {
@@ -1301,6 +1331,7 @@ int main(void) {
        test_shifting_balanced},
       {"PVRS and limiter hand values", test_pvrs_hand_values},
       {"RK4 fourth order, RK2 second order", test_rk_order},
+      {"midpoint rule: one step exact, second order, unknown refused", test_rk_midpoint},
       {"RK4 stages' stiffness: the rate of a linear system", test_rk_stiffness},
       {"wall-crossing guard, corners included", test_walls_guard},
       {"damper step limit: the probe finds Eq. 9's largest eigenvalue", test_damper_probe},

@@ -1,11 +1,13 @@
 /* Explicit Runge-Kutta over any set of per-particle state arrays. Knows no physics: a
  * state array, its derivative array (with stride and offset, so interleaved vectors
- * work) and nothing else. Two methods of the same low-storage form, where each stage
- * is evaluated at y0 + c dt k_prev:
+ * work) and nothing else. Methods of the same low-storage form, where each stage is
+ * evaluated at y0 + c dt k_prev (a stage table each, src/integrator.c):
  *   RK4: classical fourth order (paper 002 Sec. IV A), 4 derivative evaluations;
  *   RK2: Heun's method (SSP-RK2, second order), 2 evaluations. Our cheaper option:
  *        strong-stability preserving, so it keeps the limited reconstruction's
- *        monotonicity, and half the cost per step at the same dt (perf/RESULTS.md). */
+ *        monotonicity, and half the cost per step at the same dt (perf/RESULTS.md);
+ *   midpoint: the explicit midpoint rule, second order, 2 evaluations (paper 000 Eqs.
+ *        9-10 and paper 001 Eq. 13; the multiphase scheme's integrator). */
 #ifndef RHOD_INTEGRATOR_H
 #define RHOD_INTEGRATOR_H
 
@@ -14,9 +16,21 @@
 #include "rhod/status.h"
 
 #define RHOD_RK_MAX_VARS 8
+#define RHOD_RK_MAX_STAGES 4
+
+/* A method's stage table: y_{n+1} = y_n + dt/div sum_s w[s] k_s, and stage s + 1
+ * evaluated at y_n + c[s] dt k_s. */
+typedef struct {
+  int stages;
+  real div;
+  real w[RHOD_RK_MAX_STAGES], c[RHOD_RK_MAX_STAGES];
+} rhod_rk_table;
+/* The table of a method; NULL for an unknown one. */
+const rhod_rk_table *rhod_rk_table_of(rhod_integrator_kind method);
 
 typedef struct {
   rhod_integrator_kind method;
+  rhod_rk_table table;
   int stages;
   int nvars;
   real **state[RHOD_RK_MAX_VARS]; /* addresses of the store's pointers (they move on growth) */
@@ -29,6 +43,7 @@ typedef struct {
   real *d21[RHOD_RK_MAX_VARS];
 } rhod_rk;
 
+/* RHOD_ERR_SCENE for an unknown method. */
 int rhod_rk_init(rhod_rk *rk, rhod_particles *p, rhod_integrator_kind method);
 int rhod_rk_add(rhod_rk *rk, rhod_particles *p, real **state, real **deriv, int stride, int offset);
 /* Before stage 0: saves y0 and clears the sum. */

@@ -33,6 +33,10 @@ typedef struct {
   /* persistent state */
   real *x, *y, *ux, *uy, *rho, *m, *dx;
   uint64_t *id;
+  /* per-particle tags a scheme asks for (NULL until then, rhod_particles_add_tags):
+   * the phase (index into the scene's phases), the kind (a scheme's role of the particle,
+   * e.g. regular, guard, boundary) and the level of resolution; persistent, uint8 */
+  uint8_t *phase, *kind, *level;
   /* ghost description, valid at [n, n + ng): source fluid particle, position
    * Jacobian J (x' = J x + c, row-major), velocity transform T, and the
    * displacement e used for the hydrostatic correction P' = P + rho g.e */
@@ -52,6 +56,8 @@ int rhod_particles_init(rhod_particles *p, size_t cap);
 /* Registers an array of `elem` bytes per particle; allocated (and mapped) at once. */
 int rhod_particles_add_field(rhod_particles *p, const char *name, void **ptr, size_t elem,
                              int persistent);
+/* Registers the tags phase, kind and level (zero-filled, persistent). */
+int rhod_particles_add_tags(rhod_particles *p);
 /* Grows every array to at least `cap` (keeps content of persistent ones). */
 int rhod_particles_reserve(rhod_particles *p, size_t cap);
 void rhod_particles_free(rhod_particles *p);
