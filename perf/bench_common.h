@@ -5,7 +5,7 @@
 #ifndef RHOD_BENCH_COMMON_H
 #define RHOD_BENCH_COMMON_H
 
-#include "rhod/sim.h"
+#include "rhod/rhodsph/scheme.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

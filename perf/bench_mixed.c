@@ -20,11 +20,11 @@ static void time_passes(rhod_sim *s, int reps, double *ua, double *uc) {
   const double n = (double)p->n;
   double t0 = bench_now();
   for (int r = 0; r < reps; r++)
-    rhod_sph_pass_a(&s->sph, p, &s->cells);
+    rhod_sph_pass_a(&rhod_rs(s)->sph, p, &s->cells);
   *ua = 1e6 * (bench_now() - t0) / (reps * n);
   t0 = bench_now();
   for (int r = 0; r < reps; r++)
-    rhod_sph_pass_c(&s->sph, p, &s->cells);
+    rhod_sph_pass_c(&rhod_rs(s)->sph, p, &s->cells);
   *uc = 1e6 * (bench_now() - t0) / (reps * n);
 }
 
@@ -47,7 +47,7 @@ int main(int argc, char **argv) {
     return 1;
   }
   rhod_particles *p = &s.p;
-  rhod_sph_rhs(&s.sph, p, &s.cells, (real)s.dt); /* every field valid */
+  rhod_sph_rhs(&rhod_rs(&s)->sph, p, &s.cells, (real)s.dt); /* every field valid */
   /* the sizes present */
   rhod_particles_to_host(p);
   real dmin = p->dx[0], dmax = p->dx[0];
@@ -72,8 +72,8 @@ int main(int argc, char **argv) {
   const double n = (double)p->n;
   /* the reference: pass A's Gamma with our grid, for the check below */
   real *gam0 = malloc(p->n * sizeof(real));
-  rhod_to_host(s.sph.gam, p->n * sizeof(real));
-  memcpy(gam0, s.sph.gam, p->n * sizeof(real));
+  rhod_to_host(rhod_rs(&s)->sph.gam, p->n * sizeof(real));
+  memcpy(gam0, rhod_rs(&s)->sph.gam, p->n * sizeof(real));
   const double R_min = sc->radius_ratio * s.dx_min, R_max = sc->radius_ratio * sc->dx;
   for (int g = 0; g < 2; g++) {
     const double R0 = g == 0 ? R_min : R_max;
@@ -87,14 +87,14 @@ int main(int argc, char **argv) {
     rhod_cells_build(&s.cells, p->x, p->y, p->n + p->ng);
     double visited, pairs, ua, uc;
     bench_count_pairs(&s, &visited, &pairs);
-    rhod_sph_pass_a(&s.sph, p, &s.cells); /* warm-up */
+    rhod_sph_pass_a(&rhod_rs(&s)->sph, p, &s.cells); /* warm-up */
     time_passes(&s, reps, &ua, &uc);
     /* the same neighbours, in another order: Gamma equal to round-off */
-    rhod_sph_pass_a(&s.sph, p, &s.cells);
-    rhod_to_host(s.sph.gam, p->n * sizeof(real));
+    rhod_sph_pass_a(&rhod_rs(&s)->sph, p, &s.cells);
+    rhod_to_host(rhod_rs(&s)->sph.gam, p->n * sizeof(real));
     double dg = 0;
     for (size_t i = 0; i < p->n; i++)
-      dg = fmax(dg, fabs((double)(s.sph.gam[i] - gam0[i])));
+      dg = fmax(dg, fabs((double)(rhod_rs(&s)->sph.gam[i] - gam0[i])));
     char name[64];
     snprintf(name, sizeof name, "%s (cell %.3g m)",
              g == 0 ? "ours: R_min grid" : "single R_max grid", R0 / RHOD_CELL_REACH);

@@ -13,7 +13,7 @@ int main(int argc, char **argv) {
   if (bench_setup(&b, &s, N, patch, argc, argv, 4) != RHOD_OK)
     return 1;
   rhod_particles *p = &s.p;
-  rhod_sph *h = &s.sph;
+  rhod_sph *h = &rhod_rs(&s)->sph;
   const real dt = (real)s.dt;
   rhod_sph_rhs(h, p, &s.cells, dt); /* warm-up, and every field valid */
   double visited, pairs;

@@ -378,12 +378,8 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
   ck.checkpoint_every = c->ck_every;
   ck.step = c->sim.step;
   ck.reflected = c->sim.reflected;
-  ck.splits = c->sim.apr.split_total;
-  ck.merges = c->sim.apr.merged_total;
-  ck.absorbed = c->sim.apr.absorbed_total;
-  ck.ke_merged = c->sim.apr.ke_merged;
-  ck.ke_absorbed = c->sim.apr.ke_absorbed;
-  ck.stiffness = c->sim.sph.st_lambda;
+  if (c->sim.ops->save)
+    c->sim.ops->save(&c->sim, &ck); /* the scheme's scalars */
   ck.picture_range[0] = c->pic_range[0];
   ck.picture_range[1] = c->pic_range[1];
   long pos = c->csv.f ? ftell(c->csv.f) : -1;
@@ -491,14 +487,14 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
     json_object_set_new(o, "precision", json_string(RHOD_REAL_NAME));
     json_object_set_new(o, "threads", json_integer(omp_get_max_threads()));
     json_object_set_new(o, "kernels_ran_on", jstr(c->where));
+    json_object_set_new(o, "scheme", jstr(s->ops ? s->ops->name : ""));
     json_object_set_new(o, "wall_reflections", json_integer(s->reflected));
-    json_object_set_new(o, "splits", json_integer(s->apr.split_total));
-    json_object_set_new(o, "merges", json_integer(s->apr.merged_total));
-    json_object_set_new(o, "absorbed", json_integer(s->apr.absorbed_total));
-    json_object_set_new(o, "merge_dissipation", jnum(s->apr.ke_merged));
-    json_object_set_new(o, "absorb_dissipation", jnum(s->apr.ke_absorbed));
-    json_object_set_new(o, "damper_limited_steps", json_integer(s->damper_limited));
-    json_object_set_new(o, "stiffness_limited_steps", json_integer(s->stiffness_limited));
+    rhod_stat stats[RHOD_MAX_STATS];
+    const int ns = rhod_sim_stats(s, stats, RHOD_MAX_STATS);
+    for (int k = 0; k < ns; k++)
+      json_object_set_new(o, stats[k].key,
+                          stats[k].integer ? json_integer((json_int_t)stats[k].value)
+                                           : jnum(stats[k].value));
     json_object_set_new(o, "probes", probes ? probes : json_null());
   }
   char *text =
@@ -635,13 +631,11 @@ static int run(run_opts *o, const char *resume_out) {
       c.sim.t = ck.t;
       c.sim.step = ck.step;
       c.sim.reflected = ck.reflected;
-      c.sim.apr.split_total = ck.splits;
-      c.sim.apr.merged_total = ck.merges;
-      c.sim.apr.absorbed_total = ck.absorbed;
-      c.sim.apr.ke_merged = ck.ke_merged;
-      c.sim.apr.ke_absorbed = ck.ke_absorbed;
-      c.sim.sph.st_lambda = (real)ck.stiffness;
-      c.sim.dt = rhod_sph_dt(&c.sim.sph, &c.sim.p); /* sizes may have been split since t = 0 */
+      /* the scheme's scalars (and its dt: sizes may have been split since t = 0) */
+      if (c.sim.ops->load)
+        st = c.sim.ops->load(&c.sim, &ck, err, sizeof err);
+    }
+    if (st == RHOD_OK) {
       st = rhod_sim_prepare(&c.sim, 1);
       if (st != RHOD_OK)
         snprintf(err, sizeof err, "out of memory for ghost particles");
@@ -872,26 +866,17 @@ static int run(run_opts *o, const char *resume_out) {
     const double psteps = s->particle_steps;
     logline("rhod: done: %ld steps, %.3f s wall, %.4g us per particle-step", s->step, wall,
             psteps > 0 ? 1e6 * wall / psteps : 0.0);
-    if (s->apr.split_total || s->apr.merged_total)
-      logline("rhod: %ld particles split by the refinement criteria and %ld groups of %d "
-              "coalesced during the run (%zu particles now)",
-              s->apr.split_total, s->apr.merged_total, s->apr.nsplit, s->p.n);
-    if (s->apr.merged_total || s->apr.absorbed_total)
-      logline("rhod: %ld stragglers absorbed by their coarser neighbours; the merges took "
-              "%.4g J/m of kinetic energy out, the absorptions %.4g J/m",
-              s->apr.absorbed_total, s->apr.ke_merged, s->apr.ke_absorbed);
+    /* the scheme's lines (refinement, step limits), then the engine's */
+    char lines[4096];
+    rhod_warn_buf lb = {lines, sizeof lines, 0, 0};
+    lines[0] = '\0';
+    rhod_sim_report(s, s->step - c.step0, &lb);
+    for (char *line = strtok(lines, "\n"); line; line = strtok(NULL, "\n"))
+      logline("rhod: %s", line);
     if (s->reflected)
       logline("rhod: %ld particle-steps ended just behind a wall and were reflected back "
               "(docs/choices.md)",
               s->reflected);
-    if (s->damper_limited)
-      logline("rhod: %ld of the %ld steps run here took a dt set by the acoustic damper's "
-              "measured stiffness (scheme.damper_step_limit)",
-              s->damper_limited, s->step - c.step0);
-    if (s->stiffness_limited)
-      logline("rhod: %ld of the %ld steps run here took a dt set by the stiffness the RK4 "
-              "stages measured (time.stiffness_limit)",
-              s->stiffness_limited, s->step - c.step0);
     st = write_summary(&c, "ok", "", wall);
   }
   goto cleanup;

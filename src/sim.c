@@ -110,9 +110,7 @@ static int region_level(const rhod_scene *sc, double x, double y) {
   return l;
 }
 
-/* The fluid block that owns (x, y): the first block whose shape holds the point, if
- * the point is fluid (inside the domain, not behind a wall); -1 otherwise. */
-static int fluid_block_at(const rhod_sim *s, double x, double y) {
+int rhod_sim_block_at(const rhod_sim *s, double x, double y) {
   const rhod_scene *sc = s->sc;
   if (x < s->lo[0] || x > s->hi[0] || y < s->lo[1] || y > s->hi[1])
     return -1;
@@ -124,45 +122,32 @@ static int fluid_block_at(const rhod_sim *s, double x, double y) {
   return -1;
 }
 
-/* Particle k of size dx at (x, y) with the initial state of block b; id k. */
-static void set_state(rhod_sim *s, unsigned b, size_t k, double x, double y, double dx) {
+double rhod_sim_block_top(const rhod_sim *s, unsigned b) {
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
-  rhod_particles *p = &s->p;
   const double g = hypot(sc->gravity[0], sc->gravity[1]);
   const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
-  const double c2 = sc->c0 * sc->c0;
-  double P = 0;
-  if (B->pressure == RHOD_INIT_HYDROSTATIC) {
-    /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1), the free surface
-     * at fluid.N.surface (default the block's top along -g) */
-    const double top = B->surface_set ? B->surface : shape_top(&B->shape, ex, ey);
-    const double depth = top - (x * ex + y * ey);
-    P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
-  }
-  double u = B->velocity[0], v = B->velocity[1];
+  return B->surface_set ? B->surface : shape_top(&B->shape, ex, ey);
+}
+
+void rhod_sim_initial_flow(const rhod_sim *s, unsigned b, double x, double y, double rho0,
+                           double *u_out, double *v_out, double *P_out) {
+  const rhod_fluid_block *B = &s->sc->fluid[b];
+  double u = B->velocity[0], v = B->velocity[1], P = 0;
   if (B->flow == RHOD_FLOW_TAYLOR_GREEN) {
     const double kw = 2 * M_PI / B->flow_L, U = B->flow_U;
     u += U * sin(kw * x) * cos(kw * y);
     v -= U * cos(kw * x) * sin(kw * y);
-    P += sc->rho0 * U * U / 4 * (cos(2 * kw * x) + cos(2 * kw * y));
+    P = rho0 * U * U / 4 * (cos(2 * kw * x) + cos(2 * kw * y));
   } else if (B->flow == RHOD_FLOW_ROTATION) {
     const double w = B->flow_omega;
     u -= w * (y - B->flow_center[1]);
     v += w * (x - B->flow_center[0]);
-    P += rotation_pressure(sc->rho0, w, B->shape.max[0] - B->shape.min[0],
-                           B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
-                           y - B->shape.min[1]);
+    P = rotation_pressure(rho0, w, B->shape.max[0] - B->shape.min[0],
+                          B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
+                          y - B->shape.min[1]);
   }
-  const double rho = sc->rho0 + P / c2; /* Eq. 2 */
-  p->x[k] = (real)x;
-  p->y[k] = (real)y;
-  p->ux[k] = (real)u;
-  p->uy[k] = (real)v;
-  p->rho[k] = (real)rho;
-  p->m[k] = (real)(rho * dx * dx); /* m_i = rho_i(0) V_i(0) */
-  p->dx[k] = (real)dx;
-  p->id[k] = k;
+  *u_out = u, *v_out = v, *P_out = P;
 }
 
 /* Why a lattice point of block b that fluid_block_at refused is left out (s->fill). */
@@ -191,15 +176,16 @@ static void count_dropped(rhod_sim *s, unsigned b, double x, double y) {
 /* One fluid particle of size dx at (x, y) of block b, if the point belongs to block b
  * (fluid_block_at). Counts it; writes it when `write`, else keeps the fill's tally. */
 static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t *n, int write) {
-  const int owner = fluid_block_at(s, x, y);
+  const int owner = rhod_sim_block_at(s, x, y);
   if (owner != (int)b) {
     if (!write && owner < 0 && in_shape(&s->sc->fluid[b].shape, x, y))
       count_dropped(s, b, x, y);
     return;
   }
-  if (write)
-    set_state(s, b, *n, x, y, dx);
-  else
+  if (write) {
+    s->ops->initial_state(s, b, *n, x, y, dx);
+    s->p.id[*n] = *n;
+  } else
     s->fill[b].kept++;
   (*n)++;
 }
@@ -320,15 +306,7 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
   return RHOD_OK;
 }
 
-/* Each particle gets the exact initial fields of its block where it stands, as if the
- * lattice had been filled there; sizes and ids are kept. Its block is blk[id] when a
- * table is given (the block it was made in, kept across moves), else the block at its
- * place; a particle of no block (a child beyond its parent's block edge) keeps its
- * fields. With jit > 0 it is first jittered by jit times its own size (after the
- * initial criteria cascade, whose splits fall on the finer lattices of the unjittered
- * fill; the split's projected pressure and m/4 are replaced, so the masses match the
- * densities); a jitter that would take it out of its block is not applied. */
-static int restate_initial(rhod_sim *s, double jit, const int *blk) {
+int rhod_sim_restate(rhod_sim *s, double jit, const int *blk) {
   rhod_particles *p = &s->p;
   rhod_particles_to_host(p);
   uint64_t rs = 0x5eed;
@@ -336,49 +314,20 @@ static int restate_initial(rhod_sim *s, double jit, const int *blk) {
     const double x = p->x[k], y = p->y[k], dx = p->dx[k];
     const double xj = x + jit * dx * jitter_rand(&rs), yj = y + jit * dx * jitter_rand(&rs);
     const uint64_t id = p->id[k];
-    const int b = blk ? blk[id] : fluid_block_at(s, x, y);
+    const int b = blk ? blk[id] : rhod_sim_block_at(s, x, y);
     if (b < 0)
       continue;
-    const int moved = fluid_block_at(s, xj, yj) == b;
-    set_state(s, (unsigned)b, k, moved ? xj : x, moved ? yj : y, dx);
+    const int moved = rhod_sim_block_at(s, xj, yj) == b;
+    s->ops->initial_state(s, (unsigned)b, k, moved ? xj : x, moved ? yj : y, dx);
     p->id[k] = id;
   }
   rhod_particles_to_device(p);
   return rhod_sim_prepare(s, 1);
 }
 
-static int refine_initial(rhod_sim *s, char *err, size_t errlen);
-
-/* The initial relaxation (particles.relax, rhod_sph_relax): the particles move along the
- * shifting direction for that many iterations, then each gets the exact initial fields of
- * the block it was made in, where it now stands (set_state: a particle that left its
- * block, e.g. a surface particle by a fraction of dx, takes the block's fields extended
- * there). Sizes, ids and the count are kept. */
-static int relax_initial(rhod_sim *s) {
-  rhod_particles *p = &s->p;
-  rhod_particles_to_host(p);
-  /* the block of each particle, by id (the sorts of the iterations reorder them) */
-  const size_t nid = (size_t)p->next_id;
-  int *blk = malloc((nid ? nid : 1) * sizeof *blk);
-  if (!blk)
-    return RHOD_ERR_MEMORY;
-  for (size_t k = 0; k < p->n; k++)
-    blk[p->id[k]] = fluid_block_at(s, p->x[k], p->y[k]);
-  /* particles.relax_where: jumps: the largest size present bounds the test's gather */
-  real jumps_dx = 0;
-  if (s->sc->relax_where == RHOD_RELAX_JUMPS)
-    for (size_t k = 0; k < p->n; k++)
-      jumps_dx = p->dx[k] > jumps_dx ? p->dx[k] : jumps_dx;
-  int st = RHOD_OK;
-  for (int it = 0; it < s->sc->relax && st == RHOD_OK; it++) {
-    rhod_sph_relax(&s->sph, p, &s->cells, jumps_dx);
-    rhod_walls_guard(&s->bnd, p);
-    st = rhod_sim_prepare(s, 1);
-  }
-  if (st == RHOD_OK)
-    st = restate_initial(s, 0, blk);
-  free(blk);
-  return st;
+/* The probe kinds rhod_probe_values reads itself; the others are the scheme's. */
+static int engine_probe(rhod_probe_kind kind) {
+  return kind != RHOD_PROBE_ELASTIC_ENERGY && kind != RHOD_PROBE_TORQUE_BUDGET;
 }
 
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
@@ -429,20 +378,14 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
         s->lo[a] = fmin(s->lo[a], lo[a]), s->hi[a] = fmax(s->hi[a], hi[a]);
     }
   }
-  s->margin = sc->radius_ratio * sc->dx; /* particles.dx is the coarsest size (level 0) */
-  /* the finest size (triangle: by the multiplications the splits make) */
-  s->dx_min = ldexp(sc->dx, -(sc->levels - 1));
-  if (sc->pattern == RHOD_PATTERN_TRIANGLE) {
-    real dmin = (real)sc->dx;
-    for (int l = 1; l < sc->levels; l++)
-      dmin *= (real)(1 / rhod_pattern_ratio(sc->pattern));
-    s->dx_min = dmin;
+  s->ops = rhod_scheme_for(sc);
+  if (!s->ops) {
+    snprintf(err, errlen, "%s: scheme.name: this build has no such scheme", sc->path);
+    return RHOD_ERR_SCENE;
   }
-  /* Wall mirrors: a fluid particle's ghost is needed by every particle whose support
-   * crosses the wall. With one size that is within R_i of the wall; with mixed sizes
-   * a neighbour may be up to twice as large (criterion 1 keeps sizes in a support
-   * within a factor 2), so mirrors reach 2 R_i. */
-  s->mirror_ratio = sc->radius_ratio * (sc->levels > 1 ? 2 : 1);
+  s->margin = sc->radius_ratio * sc->dx; /* particles.dx is the coarsest size (level 0) */
+  s->ops->geometry(sc, &s->dx_min, &s->mirror_ratio);
+  s->mirror_ratio *= sc->radius_ratio;
   int st = rhod_particles_init(&s->p, 1024);
   if (st == RHOD_OK)
     st = rhod_boundary_init(&s->bnd, sc, s->lo, s->hi);
@@ -450,46 +393,28 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     snprintf(err, errlen, "out of memory setting up the particles");
     return st;
   }
+  rhod_particles *p = &s->p;
+  /* the integrator, then the scheme's fields and variables: their arrays grow with the
+   * fill's reservation */
+  st = rhod_rk_init(&s->rk, p, sc->integrator);
+  if (st != RHOD_OK) {
+    snprintf(err, errlen, "%s: time.integrator: unknown method", sc->path);
+    return st;
+  }
+  st = s->ops->init(s, err, errlen);
+  if (st != RHOD_OK)
+    return st;
+  /* the probes the engine does not read must be the scheme's */
+  for (unsigned i = 0; i < sc->n_probes; i++)
+    if (!engine_probe(sc->probes[i].kind) && s->ops->probe(s, &sc->probes[i], NULL) != RHOD_OK) {
+      snprintf(err, errlen, "%s: probes.list.%u: the %s probe is not available with scheme %s",
+               sc->path, i, sc->probes[i].name, s->ops->name);
+      return RHOD_ERR_SCENE;
+    }
   /* host-side fill happens before anything is sent to the device */
   st = fill_fluid(s, err, errlen);
   if (st != RHOD_OK)
     return st;
-  st = rhod_sph_init(&s->sph, sc, &s->p);
-  if (st == RHOD_OK)
-    st = rhod_rk_init(&s->rk, &s->p, s->sc->integrator);
-  rhod_particles *p = &s->p;
-  rhod_sph *h = &s->sph;
-  if (st == RHOD_OK)
-    st = rhod_rk_add(&s->rk, p, &p->x, &h->vel, 2, 0);
-  if (st == RHOD_OK)
-    st = rhod_rk_add(&s->rk, p, &p->y, &h->vel, 2, 1);
-  if (st == RHOD_OK)
-    st = rhod_rk_add(&s->rk, p, &p->ux, &h->acc, 2, 0);
-  if (st == RHOD_OK)
-    st = rhod_rk_add(&s->rk, p, &p->uy, &h->acc, 2, 1);
-  if (st == RHOD_OK)
-    st = rhod_rk_add(&s->rk, p, &p->rho, &h->drho, 1, 0);
-  /* the stiffness limit measures u and rho in the acoustic energy's scales, u / c0 and
-   * rho / rho0 (positions left out: dx/dt = u makes their stage differences those of u,
-   * a ratio near dt c0 / dx whatever the stiffness) */
-  if (st == RHOD_OK && h->stlim)
-    st = rhod_rk_watch(&s->rk, p, &p->ux, 1 / h->c0);
-  if (st == RHOD_OK && h->stlim)
-    st = rhod_rk_watch(&s->rk, p, &p->uy, 1 / h->c0);
-  if (st == RHOD_OK && h->stlim)
-    st = rhod_rk_watch(&s->rk, p, &p->rho, 1 / h->rho0);
-  if (st == RHOD_ERR_SCENE) {
-    /* the stiffness limit's weights 1/c0 and 1/rho0 (rhod_rk_watch) */
-    snprintf(err, errlen,
-             "%s: physics.c0 = %g m/s, physics.rho0 = %g kg/m^3: 1/c0 or 1/rho0 is not a finite "
-             "number in %s precision",
-             sc->path, sc->c0, sc->rho0, RHOD_REAL_NAME);
-    return st;
-  }
-  if (st != RHOD_OK) {
-    snprintf(err, errlen, "out of memory setting up the scheme");
-    return st;
-  }
   rhod_particles_to_device(p); /* the persistent state goes to the device */
   const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
   const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
@@ -500,56 +425,19 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
              s->dx_min);
     return st;
   }
-  st = rhod_apr_init(&s->apr, sc, s->dx_min);
-  if (st != RHOD_OK)
-    return st;
-  s->dt = rhod_sph_dt(&s->sph, p);
   st = rhod_sim_prepare(s, 1);
-  if (st != RHOD_OK)
-    return st;
-  if (s->apr.active)
-    st = refine_initial(s, err, errlen);
-  if (st == RHOD_OK && sc->relax > 0 && (st = relax_initial(s)) != RHOD_OK)
-    snprintf(err, errlen, "out of memory relaxing the initial particles");
+  if (st == RHOD_OK && s->ops->start)
+    st = s->ops->start(s, err, errlen);
   return st;
-}
-
-/* The initial lattice refined by the criteria (rhod_sim_init). */
-static int refine_initial(rhod_sim *s, char *err, size_t errlen) {
-  const rhod_scene *sc = s->sc;
-  rhod_particles *p = &s->p;
-  int st;
-  /* The initial lattice is refined by the criteria before the first step, until none
-   * asks for more, so the run starts from a layout that satisfies them (paper 002
-   * Sec. V B: "the initial particle setup is chosen to naturally ensure the criteria")
-   * instead of splitting in cascade once it moves. A split near the surface can make
-   * criterion 1 split its coarser neighbours in the next round, and so on inward, so
-   * levels - 1 rounds are not always enough (the dam break still split 64, 139 and 507
-   * particles in its first step at three, four and seven levels with that limit); the
-   * cap of 4 levels rounds only bounds a cascade that would not settle. */
-  for (int round = 1; round < 4 * sc->levels; round++) {
-    rhod_sph_rhs(&s->sph, p, &s->cells, (real)s->dt);
-    st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, 0, 0);
-    const long split = st == RHOD_OK ? rhod_apr_split(&s->apr, &s->sph, p, &s->bnd) : -1;
-    if (split < 0) {
-      snprintf(err, errlen, "out of memory refining the initial particles");
-      return RHOD_ERR_MEMORY;
-    }
-    if (split == 0)
-      break;
-    s->dt = rhod_sph_dt(&s->sph, p);
-    st = rhod_sim_prepare(s, 1);
-    if (st != RHOD_OK)
-      return st;
-  }
-  s->apr.split_total = 0;
-  return restate_initial(s, sc->jitter, NULL);
 }
 
 void rhod_sim_free(rhod_sim *s) {
   free(s->fill);
   s->fill = NULL;
-  rhod_apr_free(&s->apr);
+  if (s->ops && s->ops->free)
+    s->ops->free(s);
+  free(s->sch);
+  s->sch = NULL;
   rhod_cells_free(&s->cells);
   rhod_boundary_free(&s->bnd);
   rhod_particles_free(&s->p);
@@ -604,7 +492,7 @@ int rhod_sim_prepare(rhod_sim *s, int sort) {
     return st;
   if (rhod_cells_reserve(&s->cells, p->cap) != RHOD_OK)
     return RHOD_ERR_MEMORY;
-  rhod_sph_fill_state(&s->sph, p);
+  s->ops->ghost_state(s);
   rhod_cells_build(&s->cells, p->x, p->y, p->n + p->ng);
   s->neighbours_fresh = 1;
   return RHOD_OK;
@@ -656,20 +544,7 @@ static int check_state(rhod_sim *s, char *err, size_t errlen) {
   return RHOD_ERR_UNSTABLE;
 }
 
-int rhod_sim_dt(rhod_sim *s) {
-  if (s->sph.adlim) {
-    if (!s->neighbours_fresh) {
-      const int st = rhod_sim_prepare(s, 1);
-      if (st != RHOD_OK)
-        return st;
-    }
-    s->sph.ad_lambda = rhod_sph_damper_probe(&s->sph, &s->p, &s->cells);
-  }
-  s->dt = rhod_sph_dt(&s->sph, &s->p);
-  s->damper_limited += s->sph.dt_by == RHOD_DT_BY_DAMPER;
-  s->stiffness_limited += s->sph.dt_by == RHOD_DT_BY_STIFFNESS;
-  return RHOD_OK;
-}
+int rhod_sim_dt(rhod_sim *s) { return s->ops->dt(s); }
 
 int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   rhod_particles *p = &s->p;
@@ -686,24 +561,9 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
       if (st != RHOD_OK)
         goto mem;
     }
-    rhod_sph_rhs(&s->sph, p, &s->cells, (real)dt);
-    /* the stiffness limit (docs/choices.md): the RK4 stages' stiffness over the inner
-     * particles, where the right-hand side is smooth (the free-surface region switches
-     * operators and sets between stages, which the stage differences would read as a
-     * stiffness of order 1/dt) */
-    if (stage == 2 && s->sph.stlim) {
-      const real q = rhod_rk_stiffness(&s->rk, p, (real)dt, s->sph.reg);
-      s->sph.st_lambda = q < 0 ? -q : 0;
-    }
-    /* refinement criteria during the last stage (paper 002 Sec. V) */
-    if (s->apr.active && stage == s->rk.stages - 1) {
-      /* coalescing is looked for every RHOD_COALESCE_EVERY steps: its candidate
-       * test gathers over twice the support (docs/choices.md "APR coalescing") */
-      const int co = s->step % RHOD_COALESCE_EVERY == 0;
-      st = rhod_apr_mark(&s->apr, &s->sph, p, &s->cells, &s->bnd, s->t + dt, co);
-      if (st != RHOD_OK)
-        goto mem;
-    }
+    st = s->ops->rhs(s, stage, s->t, (real)dt);
+    if (st != RHOD_OK)
+      goto mem;
     rhod_rk_stage(&s->rk, p, stage, (real)dt);
   }
   s->neighbours_fresh = 0;
@@ -712,20 +572,24 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   s->step++;
   s->particle_steps += (double)p->n;
   st = check_state(s, err, errlen);
-  if (st != RHOD_OK || !s->apr.active)
+  if (st != RHOD_OK || !s->ops->end_step)
     return st;
-  /* the marked particles split before the next step, which sorts them in */
-  if (rhod_apr_split(&s->apr, &s->sph, p, &s->bnd) < 0) {
-    st = RHOD_ERR_MEMORY;
+  st = s->ops->end_step(s);
+  if (st != RHOD_OK)
     goto mem;
-  }
-  rhod_apr_coalesce(&s->apr, p);
-  if (s->apr.split_last > 0 || s->apr.merged_last > 0 || s->apr.absorbed_last > 0)
-    s->dt = rhod_sph_dt(&s->sph, p);
   return RHOD_OK;
 mem:
   snprintf(err, errlen, "out of memory for %zu particles at t = %g s", p->n, s->t);
   return st;
+}
+
+int rhod_sim_stats(const rhod_sim *s, rhod_stat *out, int max) {
+  return s->ops && s->ops->stats ? s->ops->stats(s, out, max) : 0;
+}
+
+void rhod_sim_report(const rhod_sim *s, long steps, rhod_warn_buf *w) {
+  if (s->ops && s->ops->report)
+    s->ops->report(s, steps, w);
 }
 
 unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MAX],
@@ -746,12 +610,11 @@ unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MA
 void rhod_probe_values(rhod_sim *s, double *values) {
   const rhod_scene *sc = s->sc;
   rhod_particles *p = &s->p;
-  rhod_sph *h = &s->sph;
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
-  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *m = p->m, *P = h->P, *V = h->V;
-  const int kern = h->kernel;
-  const real *dx = p->dx, ratio = h->ratio;
-  const real gx = h->gx, gy = h->gy;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *m = p->m, *P = *s->P, *V = *s->V;
+  const int kern = sc->kernel;
+  const real *dx = p->dx, ratio = (real)sc->radius_ratio;
+  const real gx = (real)sc->gravity[0], gy = (real)sc->gravity[1];
   unsigned k = 0;
   for (unsigned i = 0; i < sc->n_probes; i++) {
     const rhod_probe *pr = &sc->probes[i];
@@ -816,29 +679,6 @@ void rhod_probe_values(rhod_sim *s, double *values) {
       values[k++] = b;
       break;
     }
-    case RHOD_PROBE_ELASTIC_ENERGY: {
-      /* The energy stored by compression: with the linear state law of paper 002
-       * Eq. 2, P = c0^2 (rho - rho0), the work per unit mass
-       * e = int_rho0^rho P / r^2 dr = c0^2 (ln(rho/rho0) + rho0/rho - 1), or with
-       * q = 1 - rho0/rho, e = c0^2 (-ln(1 - q) - q) = c0^2 (q^2/2 + q^3/3 + ...). The
-       * series (to q^5, relative error below q^4/3) where |q| < 0.01 avoids the
-       * cancellation of the closed form in single precision. Conservative SPH without
-       * the diffusive terms conserves E_k + E_e (tests). */
-      const real c2 = h->c0 * h->c0, rho0 = h->rho0;
-      const real *rho = p->rho;
-      real e = 0;
-      RHOD_KERNEL_LOOP_REDUCE(+, e)
-      for (long j = 0; j < n; j++) {
-        const real q = 1 - rho0 / rho[j];
-        const real f =
-            fabs(q) < (real)0.01
-                ? q * q * ((real)0.5 + q * ((real)1 / 3 + q * ((real)0.25 + q * (real)0.2)))
-                : -log1p(-q) - q;
-        e += m[j] * c2 * f;
-      }
-      values[k++] = e;
-      break;
-    }
     case RHOD_PROBE_ANGULAR_MOMENTUM: {
       real a = 0;
       RHOD_KERNEL_LOOP_REDUCE(+, a)
@@ -847,15 +687,11 @@ void rhod_probe_values(rhod_sim *s, double *values) {
       values[k++] = a;
       break;
     }
-    case RHOD_PROBE_TORQUE_BUDGET: {
-      /* one value per column the loader and rhod_probe_columns count for this kind */
-      _Static_assert(RHOD_TQ_TERMS == RHOD_PROBE_MAX_COLUMNS, "torque_budget columns");
-      double tq[RHOD_TQ_TERMS];
-      rhod_sph_torque_budget(h, p, &s->cells, (real)s->dt, ax, ay, tq);
-      for (int a = 0; a < RHOD_TQ_TERMS; a++)
-        values[k++] = tq[a];
+    default:
+      /* the scheme's own probes (rhod_sim_init refused those it has not) */
+      s->ops->probe(s, pr, values + k);
+      k += rhod_probe_ncolumns(pr->kind);
       break;
-    }
     }
   }
 }
@@ -863,32 +699,16 @@ void rhod_probe_values(rhod_sim *s, double *values) {
 void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
   rhod_particles *p = &s->p;
   const size_t n = p->n;
-  /* P and the free-surface flags are refreshed for the prepared state: the flags of
-   * the last stage belong to the particle order before the step's sort (and to the
-   * stage's positions), so they are detected again here when the neighbours are
-   * fresh (pass A gives lambda, L and grad Gamma) */
-  rhod_sph_fill_state(&s->sph, p);
-  if (s->neighbours_fresh) {
-    rhod_sph_pass_a(&s->sph, p, &s->cells);
-    rhod_sph_pass_free_surface(&s->sph, p, &s->cells);
-  }
-  real *const f[8] = {p->x, p->y, p->ux, p->uy, p->rho, s->sph.P, p->m, p->dx};
-  for (int k = 0; k < 8; k++)
+  *v = (rhod_snapshot_view){0};
+  s->ops->output(s, v); /* the scheme's fields (pressure, free surface ...) */
+  real *const f[7] = {p->x, p->y, p->ux, p->uy, p->rho, p->m, p->dx};
+  for (int k = 0; k < 7; k++)
     rhod_to_host(f[k], n * sizeof(real));
   rhod_to_host(p->id, n * sizeof(uint64_t));
-  rhod_to_host(s->sph.fs, n);
-  *v = (rhod_snapshot_view){.time = s->t,
-                            .n = n,
-                            .x = p->x,
-                            .y = p->y,
-                            .ux = p->ux,
-                            .uy = p->uy,
-                            .rho = p->rho,
-                            .p = s->sph.P,
-                            .m = p->m,
-                            .size = p->dx,
-                            .id = p->id,
-                            .fs = s->sph.fs};
+  v->time = s->t;
+  v->n = n;
+  v->x = p->x, v->y = p->y, v->ux = p->ux, v->uy = p->uy, v->rho = p->rho;
+  v->m = p->m, v->size = p->dx, v->id = p->id;
 }
 
 /* ---- warnings about the particles as set up -------------------------------------------- */

@@ -14,7 +14,8 @@ TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 bad=0
 checked=0
-for f in $(grep -l -E "RHOD_KERNEL_LOOP|omp target" "$SRC"/kernels/*.c "$SRC"/src/*.c); do
+for f in $(grep -l -E "RHOD_KERNEL_LOOP|omp target" "$SRC"/kernels/*.c "$SRC"/kernels/*/*.c "$SRC"/src/*.c \
+  "$SRC"/src/*/*.c); do
   b=$(basename "$f" .c)
   (cd "$TMP" && gcc -O2 "${FLAGS[@]}" -I"$SRC/include" -I"$SRC/kernels" -I"$SRC/src" \
     -DRHOD_OFFLOAD=1 -c "$f" -o "$b.o" &&

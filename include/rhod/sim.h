@@ -1,5 +1,6 @@
-/* A simulation: the engine (particles, ghosts, cells, integrator) driving the RHOD-SPH
- * scheme for one scene. Library code: returns rhod_status codes with a message. */
+/* A simulation: the engine (particles, ghosts, cells, integrator) driving one scheme
+ * (include/rhod/scheme.h) for one scene. Library code: returns rhod_status codes with a
+ * message. */
 #ifndef RHOD_SIM_H
 #define RHOD_SIM_H
 
@@ -8,12 +9,8 @@
 #include "rhod/integrator.h"
 #include "rhod/io.h"
 #include "rhod/particles.h"
-#include "rhod/rhodsph/apr.h"
-#include "rhod/rhodsph/sph.h"
 #include "rhod/scene.h"
-
-/* Steps between two searches for coalescing groups (refinement.coalesce). */
-#define RHOD_COALESCE_EVERY 10
+#include "rhod/scheme.h"
 
 /* What the initial fill did with one fluid block's lattice points: those inside its shape
  * that became particles, and those left out, by cause (the first wall named). Points
@@ -27,32 +24,47 @@ typedef struct {
   int obstacle, container; /* the first such wall's index, -1 if none */
 } rhod_fill_stats;
 
-typedef struct {
+typedef struct rhod_sim {
   const rhod_scene *sc;
-  rhod_fill_stats *fill; /* per fluid block, from rhod_sim_init */
+  const rhod_scheme_ops *ops; /* the scheme (rhod_scheme_for) */
+  void *sch;                  /* its state, made by ops->init */
+  rhod_fill_stats *fill;      /* per fluid block, from rhod_sim_init */
   rhod_particles p;
   rhod_boundary bnd;
   rhod_cells cells;
-  rhod_sph sph;
-  rhod_rk rk;
-  rhod_apr apr;
+  rhod_rk rk;          /* made with the scene's time.integrator; the scheme adds its variables */
+  real **P, **V;       /* the scheme's pressure and volume over fluid and ghosts after
+                          ops->ghost_state (addresses of its pointers: the store moves them) */
   double lo[2], hi[2]; /* domain box */
   double margin;       /* ghost layer width: largest kernel radius */
   double dx_min;       /* finest particle size the scene allows */
   double mirror_ratio; /* wall mirrors within mirror_ratio * dx_i of a wall */
   double t, dt;
   long step;
-  double particle_steps;  /* sum over the steps run by this process of the particle count */
-  long reflected;         /* particles put back by the wall-crossing guard, whole run */
-  long damper_limited;    /* steps of this process whose dt the damper step limit set */
-  long stiffness_limited; /* ... and those whose dt the stiffness limit set */
-  int neighbours_fresh;   /* ghosts and cells match the current state */
+  double particle_steps; /* sum over the steps run by this process of the particle count */
+  long reflected;        /* particles put back by the wall-crossing guard, whole run */
+  int neighbours_fresh;  /* ghosts and cells match the current state */
 } rhod_sim;
 
-/* Fills the fluid from the scene (square lattice of spacing dx, initial pressure) and
- * sets everything up on the device. */
+/* Fills the fluid from the scene (square lattice of spacing dx, each particle's initial
+ * state from the scheme the scene names) and sets everything up on the device. */
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen);
 void rhod_sim_free(rhod_sim *s);
+
+/* For schemes. The fluid block that owns (x, y): the first whose shape holds it, if it is
+ * fluid (inside the domain, not behind a wall); -1 otherwise. */
+int rhod_sim_block_at(const rhod_sim *s, double x, double y);
+/* The initial flow of block b at (x, y) for a fluid of density rho0: the block's velocity
+ * plus its analytic flow (fluid.N.initial), and that flow's pressure (0 without one). */
+void rhod_sim_initial_flow(const rhod_sim *s, unsigned b, double x, double y, double rho0,
+                           double *u, double *v, double *P);
+/* The free surface's level of block b along -g (fluid.N.surface, or its highest point). */
+double rhod_sim_block_top(const rhod_sim *s, unsigned b);
+/* Each particle gets the initial state of its block where it stands (ops->initial_state),
+ * sizes and ids kept: its block is blk[id] when a table is given, else the block at its
+ * place; a particle of no block keeps its fields. With jit > 0 it is first jittered by
+ * jit times its own size, unless that takes it out of its block. Then prepares (sorted). */
+int rhod_sim_restate(rhod_sim *s, double jit, const int *blk);
 
 /* Warnings about the particles as set up (after rhod_sim_init), one line each into buf,
  * separated by '\n': fluid left out of a block by walls or the domain, pressure probes
@@ -68,14 +80,14 @@ int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len);
  * sort != 0). After it, probes and outputs see consistent ghost values. */
 int rhod_sim_prepare(rhod_sim *s, int sort);
 
-/* Sets s->dt for the next step: Eq. 11, and with the damper step limit a measurement of
- * the damper's stiffness first (rhod_sph_damper_probe; one per call, so call it once per
- * step). Returns RHOD_OK or RHOD_ERR_MEMORY. */
+/* Sets s->dt for the next step (the scheme's ops->dt; RHOD-SPH measures the damper's
+ * stiffness there, so call it once per step). Returns RHOD_OK or RHOD_ERR_MEMORY. */
 int rhod_sim_dt(rhod_sim *s);
 
-/* One RK4 step of size s->dt (clipped by the caller). Then checks the new state:
- * RHOD_ERR_UNSTABLE with the particle and the cause in err when it is not finite or a
- * particle left the domain; the state is then left as computed (not written out). */
+/* One step of size dt (s->dt clipped by the caller) with the scene's integrator, then the
+ * scheme's end-of-step work. Checks the new state first: RHOD_ERR_UNSTABLE with the
+ * particle and the cause in err when it is not finite or a particle left the domain; the
+ * state is then left as computed (not written out). */
 int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen);
 
 /* Probe columns: names (momentum probes give two, NAME_x and NAME_y, written into the
@@ -88,5 +100,10 @@ void rhod_probe_values(rhod_sim *s, double *values);
 /* Brings the fluid's output fields to the host and points a snapshot view at them
  * (valid until the next step). */
 void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v);
+
+/* The scheme's statistics and end-of-run lines (ops->stats, ops->report); none when the
+ * scheme has no such hook. */
+int rhod_sim_stats(const rhod_sim *s, rhod_stat *out, int max);
+void rhod_sim_report(const rhod_sim *s, long steps, rhod_warn_buf *w);
 
 #endif

@@ -1,0 +1,77 @@
+/* The seam between the engine's driver (src/sim.c) and a scheme: host-side hooks the
+ * driver calls at fixed points of a run. The engine fills the lattice, builds ghosts and
+ * cells, integrates the variables a scheme registered (rhod_rk_add), checks the state and
+ * reads the probes and output fields every scheme shares; the scheme computes its
+ * right-hand side and time step and does its own end-of-step work (RHOD-SPH's split and
+ * merge). Kernels never see these pointers: each hook calls the scheme's own passes.
+ *
+ * A scheme is one const rhod_scheme_ops; src/schemes.c (the application's registry, the
+ * one file that names every scheme) picks it from the scene (scheme.name). */
+#ifndef RHOD_SCHEME_H
+#define RHOD_SCHEME_H
+
+#include "rhod/checkpoint.h"
+#include "rhod/config.h"
+#include "rhod/io.h"
+#include "rhod/scene.h"
+#include <stddef.h>
+
+struct rhod_sim;
+
+/* A run statistic a scheme reports: a summary.json key and its value (integer or not). */
+typedef struct {
+  const char *key;
+  double value;
+  int integer;
+} rhod_stat;
+#define RHOD_MAX_STATS 16
+
+typedef struct rhod_scheme_ops {
+  const char *name; /* scheme.name */
+  /* Before the fill (s->sc, s->lo, s->hi set): the finest particle size the scene allows,
+   * and how far wall mirrors reach, in units of a particle's kernel radius R_i. */
+  void (*geometry)(const rhod_scene *sc, double *dx_min, double *mirror_reach);
+  /* The initial state of particle k of fluid block b at (x, y), size dx: every persistent
+   * field the scheme's variables need (the engine has set nothing but the id). Called on
+   * the host during the fill and by rhod_sim_restate. */
+  void (*initial_state)(struct rhod_sim *s, unsigned b, size_t k, double x, double y, double dx);
+  /* After the fill, before anything is on the device: the scheme's state (s->sch), its
+   * fields, its integrated variables (s->rk, made by the engine with the scene's method)
+   * and the pressure and volume arrays the engine's probes read (s->P, s->V). */
+  int (*init)(struct rhod_sim *s, char *err, size_t errlen);
+  /* After the first prepare (ghosts and cells built): initial work before t = 0 (RHOD-SPH:
+   * the initial refinement and relaxation). May be NULL. */
+  int (*start)(struct rhod_sim *s, char *err, size_t errlen);
+  void (*free)(struct rhod_sim *s);
+  /* After the ghosts are built and before any gather: the ghosts' values from their
+   * sources and the fluid's equation of state. */
+  void (*ghost_state)(struct rhod_sim *s);
+  /* The right-hand side of stage `stage` of the step from t of size dt (ghosts and cells
+   * current): fills the derivatives of the registered variables. Stage work (RHOD-SPH's
+   * stiffness measure and refinement criteria) belongs here. Returns a status. */
+  int (*rhs)(struct rhod_sim *s, int stage, double t, real dt);
+  /* Sets s->dt for the next step (may call rhod_sim_prepare). */
+  int (*dt)(struct rhod_sim *s);
+  /* After a step that passed the state check: end-of-step work. May be NULL. */
+  int (*end_step)(struct rhod_sim *s);
+  /* A probe the engine does not read itself (rhod_probe_values): its columns into out.
+   * RHOD_ERR_SCENE when the scheme has no such probe. */
+  int (*probe)(struct rhod_sim *s, const rhod_probe *pr, double *out);
+  /* The scheme's output fields for the prepared state, on the host, into v (pressure,
+   * free surface, phase ...); the engine adds the particles' own. */
+  void (*output)(struct rhod_sim *s, rhod_snapshot_view *v);
+  /* Statistics for the summary (count returned) and log lines for the end of a run
+   * (rhod_warn into w). Either may be NULL. */
+  int (*stats)(const struct rhod_sim *s, rhod_stat *out, int max);
+  void (*report)(const struct rhod_sim *s, long steps, rhod_warn_buf *w);
+  /* Checkpoint extras: the scheme's scalars a run carries on (ck->extra), saved into a
+   * checkpoint and taken back from one on resume (after the particles are applied).
+   * Either may be NULL. */
+  void (*save)(const struct rhod_sim *s, rhod_checkpoint *ck);
+  int (*load)(struct rhod_sim *s, const rhod_checkpoint *ck, char *err, size_t errlen);
+} rhod_scheme_ops;
+
+/* The scheme a scene asks for (src/schemes.c); NULL when the build has none by that name. */
+const rhod_scheme_ops *rhod_scheme_for(const rhod_scene *sc);
+
+#endif
