@@ -83,4 +83,15 @@ static inline rhod_point rhod_walls_keep_off(const real *seg, int nseg, const re
  * +HUGE_VAL when there are no walls. Host side, for setup. */
 double rhod_wall_distance(const rhod_boundary *b, double x, double y);
 
+/* Ghost fields from their sources (kernels/ghost_map.c), for the ghosts [n, n + ng) that
+ * rhod_ghosts_build made (gsrc, gJ, gT set); device loops over the ghosts only. */
+/* f[g] = f[gsrc[g]]: a scalar (density, pressure, a tag) */
+void rhod_ghosts_map_scalar(const rhod_particles *p, real *f);
+void rhod_ghosts_map_u8(const rhod_particles *p, uint8_t *f);
+/* v_g = J v_src for a vector stored 2 per particle (a normal, a gradient of a scalar) */
+void rhod_ghosts_map_vector(const rhod_particles *p, real *v);
+/* (vx, vy)_g = T (vx, vy)_src: a velocity (T is J for free slip and periodic images,
+ * -I for no slip) */
+void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy);
+
 #endif

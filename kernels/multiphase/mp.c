@@ -1,0 +1,336 @@
+/* The multiphase scheme's passes (paper 000 Sec. 2, regular particles; paper 001 Sec. 2.1
+ * for the terms paper 000 cites; order of ../shared/design/multiphase.md section A).
+ * Every pass is a gather over the fluid [0, n): it writes only particle i's entries.
+ * Conventions: r_ij = r_i - r_j, grad W_ij = W'(r; R_i) r_ij / r (points from i towards
+ * j), W taken with the radius R_i = ratio dx_i of the gathering particle, V = m / rho. */
+#include "rhod/multiphase/mp.h"
+#include "multiphase/mp_pair.h"
+#include "rhod/boundary.h"
+#include "rhod/kernel.h"
+#include <math.h>
+#include <string.h>
+
+#define MAXP RHOD_MP_MAX_PHASES
+#define BIG ((real)1e30)
+
+/* h / R of a kernel (paper 000 Appendix A): Wendland h = R/2 (h/dx = 2 at R = 4 dx),
+ * quintic spline h = R/3 (h/dx = 1 at R = 3 dx). */
+static real h_over_R(int kernel) { return kernel == RHOD_KERNEL_QUINTIC ? (real)(1.0 / 3) : 0.5; }
+
+/* h_s / R with h_s = 2 sigma (paper 001 after Eq. 3 and Eqs. 14-17), sigma the kernel's
+ * standard deviation along one axis: sigma^2 = (1/2) int r^2 W dA over the unit support,
+ * by the midpoint rule (0.52705 Wendland C2, 0.46057 Wendland C4, 0.46336 quintic;
+ * docs/choices.md). */
+static real hs_over_R(int kernel) {
+  const int N = 20000;
+  double s = 0;
+  for (int k = 0; k < N; k++) {
+    const double q = (k + 0.5) / N;
+    s += 0.5 * q * q * (double)rhod_Wq(kernel, (real)q) * 2 * RHOD_PI * q / N;
+  }
+  return (real)(2 * sqrt(s));
+}
+
+int rhod_mp_init(rhod_mp *m, const rhod_mp_params *prm, rhod_particles *p) {
+  memset(m, 0, sizeof *m);
+  if (prm->nphase < 1 || prm->nphase > MAXP)
+    return RHOD_ERR_SCENE;
+  if (prm->kernel != RHOD_KERNEL_WENDLAND_C2 && prm->kernel != RHOD_KERNEL_WENDLAND_C4 &&
+      prm->kernel != RHOD_KERNEL_QUINTIC)
+    return RHOD_ERR_SCENE;
+  m->prm = *prm;
+  m->hfac = h_over_R(prm->kernel);
+  m->hs_fac = hs_over_R(prm->kernel);
+  m->tab = rhod_dev_calloc(RHOD_MP_TAB_SIZE, sizeof(real));
+  if (!m->tab)
+    return RHOD_ERR_MEMORY;
+  real *T = m->tab;
+  for (int k = 0; k < prm->nphase; k++) {
+    T[RHOD_MP_TAB_RHO0 * MAXP + k] = prm->ph[k].rho0;
+    T[RHOD_MP_TAB_C * MAXP + k] = prm->ph[k].c;
+    T[RHOD_MP_TAB_GAMMA * MAXP + k] = prm->ph[k].gamma;
+    T[RHOD_MP_TAB_MU * MAXP + k] = prm->ph[k].mu;
+    T[RHOD_MP_TAB_COLOUR * MAXP + k] = prm->ph[k].colour;
+    real smax = 0;
+    for (int b = 0; b < prm->nphase; b++) {
+      const real s = prm->sigma[k * MAXP + b];
+      T[RHOD_MP_TAB_SIGMA * MAXP + k * MAXP + b] = s;
+      smax = s > smax ? s : smax;
+      if (s > 0)
+        m->surface = 1;
+    }
+    T[RHOD_MP_TAB_SIGMA_MAX * MAXP + k] = smax;
+  }
+  rhod_to_device(m->tab, RHOD_MP_TAB_SIZE * sizeof(real));
+  int st = rhod_particles_add_tags(p);
+#define F(var, k)                                                                                  \
+  if (st == RHOD_OK)                                                                               \
+  st = rhod_particles_add_field(p, "mp_" #var, (void **)&m->var, (k) * sizeof(*m->var), 0)
+  F(P, 1);
+  F(V, 1);
+  F(us, 2);
+  F(drho, 1);
+  F(acc, 2);
+  F(vel, 2);
+  if (m->surface) { /* a scene without surface tension does not carry them */
+    F(gC, 2);
+    F(nrm, 2);
+    F(sig, 1);
+    F(kap, 1);
+  }
+#undef F
+  return st;
+}
+
+void rhod_mp_free(rhod_mp *m) {
+  rhod_dev_free(m->tab, RHOD_MP_TAB_SIZE * sizeof(real));
+  m->tab = NULL;
+}
+
+real rhod_mp_pressure(const rhod_mp_params *prm, int phase, real rho) {
+  const rhod_mp_phase *f = &prm->ph[phase];
+  return rhod_mp_eos(f->rho0, f->c, f->gamma, rho); /* paper 000 Eq. 3 */
+}
+
+real rhod_mp_density(const rhod_mp_params *prm, int phase, real P) {
+  const rhod_mp_phase *f = &prm->ph[phase];
+  return rhod_mp_eos_inv(f->rho0, f->c, f->gamma, P); /* inverse of paper 000 Eq. 3 */
+}
+
+void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
+  const long n = (long)p->n;
+  const real *rho = p->rho, *mass = p->m, *T = m->tab;
+  const uint8_t *ph = p->phase;
+  real *P = m->P, *V = m->V;
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < n; i++) {
+    const int k = ph[i];
+    P[i] = rhod_mp_eos(T[RHOD_MP_TAB_RHO0 * MAXP + k], T[RHOD_MP_TAB_C * MAXP + k],
+                       T[RHOD_MP_TAB_GAMMA * MAXP + k], rho[i]); /* paper 000 Eq. 3 */
+    V[i] = mass[i] / rho[i];
+  }
+  /* ghosts: plain copies of the source's state (no hydrostatic correction), the velocity
+   * through T (free slip, no slip, periodic images) */
+  rhod_ghosts_map_velocity(p, p->ux, p->uy);
+  rhod_ghosts_map_scalar(p, p->rho);
+  rhod_ghosts_map_scalar(p, m->P);
+  rhod_ghosts_map_scalar(p, m->V);
+  rhod_ghosts_map_u8(p, p->phase);
+}
+
+/* Pass 1 (only with surface tension): the colour gradient of Adami et al. with the
+ * density-weighted colour (paper 001 Eq. 8 with f_ij of Eq. 39 and c~_ij of multiphase.md),
+ * the interface normal (Eq. 9) where it is reliable (RHOD_MP_NORMAL_EPS, docs/choices.md),
+ * and the surface tension of i's interface: the W-weighted mean of sigma(phase_i,
+ * phase_j) over the neighbours j of another colour (our choice for more than two phases;
+ * exactly the pair's sigma for two). */
+void rhod_mp_pass_colour(rhod_mp *m, rhod_particles *p, const rhod_cells *c) {
+  const long n = (long)p->n;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *rho = p->rho, *V = m->V, *T = m->tab;
+  const uint8_t *ph = p->phase;
+  real *gC = m->gC, *nrm = m->nrm, *sig = m->sig;
+  const int kern = m->prm.kernel;
+  const real ratio = m->prm.ratio, hfac = m->hfac;
+  RHOD_GATHER_LOOP
+  for (long i = 0; i < n; i++) {
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], iR = 1 / Ri, R2 = Ri * Ri;
+    const real rhoi = rho[i], Vi = V[i];
+    const int pi = ph[i];
+    const real ci = T[RHOD_MP_TAB_COLOUR * MAXP + pi];
+    real gx = 0, gy = 0, ww = 0, sw = 0, rw = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
+      const real rx = xi - x[j], ry = yi - y[j], r2 = rx * rx + ry * ry;
+      if (!(r2 < R2 && r2 > 0))
+        continue;
+      const real r = sqrt(r2), q = r * iR;
+      const real dWr = rhod_dWq(kern, q) * iR * iR * iR / r; /* grad W_ij = dWr r_ij */
+      const int pj = ph[j];
+      const real cj = T[RHOD_MP_TAB_COLOUR * MAXP + pj];
+      /* paper 001 Eq. 8: (1/V_i) sum_j f_ij grad W_ij, f_ij = (V_i^2 + V_j^2) c~_ij */
+      const real f = rhod_mp_colour_f(Vi, V[j], rhoi, rho[j], ci, cj);
+      gx += f * dWr * rx;
+      gy += f * dWr * ry;
+      if (cj != ci) {
+        const real w = rhod_Wq(kern, q) * iR * iR;
+        ww += w;
+        sw += T[RHOD_MP_TAB_SIGMA * MAXP + pi * MAXP + pj] * w;
+        rw += rhoi / (rhoi + rho[j]) * w;
+      }
+    }
+    RHOD_END_NEIGHBOURS
+    gx /= Vi;
+    gy /= Vi;
+    gC[2 * i] = gx, gC[2 * i + 1] = gy;
+    sig[i] = ww > 0 ? sw / ww : 0;
+    const real g = sqrt(gx * gx + gy * gy), h = hfac * Ri;
+    /* paper 001 Eq. 9, where reliable: Morris' |grad C| > 0.01/h, scaled by the density
+     * weight (2 rw/ww = 1 for equal densities) that Adami's colour gives i's side */
+    const int ok = ww > 0 && g > RHOD_MP_NORMAL_EPS * 2 * (rw / ww) / h;
+    nrm[2 * i] = ok ? gx / g : 0;
+    nrm[2 * i + 1] = ok ? gy / g : 0;
+  }
+  /* the ghosts' gradients and normals from their sources: vectors map with J */
+  rhod_ghosts_map_vector(p, m->gC);
+  rhod_ghosts_map_vector(p, m->nrm);
+}
+
+/* Pass 2: continuity (paper 000 Eq. 1), momentum (Eq. 2 with paper 001 Eq. 5's switch),
+ * viscosity (paper 001 Eq. 6), the CSF curvature and force (paper 001 Eqs. 7 and 10) and
+ * the shifting velocity (paper 000 Eqs. 4-7). */
+void rhod_mp_pass_main(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt) {
+  const long n = (long)p->n;
+  const rhod_grid G = c->g;
+  const int32_t *CS = c->start, *CI = c->idx;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *rho = p->rho, *mass = p->m, *ux = p->ux,
+             *uy = p->uy, *V = m->V, *P = m->P, *T = m->tab;
+  const uint8_t *ph = p->phase;
+  const real *gC = m->gC, *nrm = m->nrm, *sig = m->sig;
+  real *kap = m->kap, *drho = m->drho, *acc = m->acc, *vel = m->vel, *us = m->us;
+  const rhod_mp_params *q_ = &m->prm;
+  const int kern = q_->kernel, tensile = q_->tensile, surface = m->surface;
+  const real ratio = q_->ratio, hfac = m->hfac, delta = q_->delta, eta2 = q_->eta2;
+  const real xi_shift = q_->xi_shift, xi_rep = q_->xi_rep, rep_n = q_->rep_n, xi_rif = q_->xi_rif,
+             gxb = q_->gx, gyb = q_->gy;
+  const real alpha = 1; /* regular particles (paper 000 Eq. 7, Fig. 11) */
+  int visc = 0;
+  for (int k = 0; k < q_->nphase; k++)
+    visc |= q_->ph[k].mu > 0;
+  RHOD_GATHER_LOOP
+  for (long i = 0; i < n; i++) {
+    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], iR = 1 / Ri, R2 = Ri * Ri;
+    const real h = hfac * Ri, eta2h = eta2 * h * h;
+    const real rhoi = rho[i], Pi = P[i], uxi = ux[i], uyi = uy[i];
+    const int pi = ph[i];
+    const real ci = T[RHOD_MP_TAB_C * MAXP + pi], nui = T[RHOD_MP_TAB_MU * MAXP + pi] / rhoi;
+    /* paper 001 Eq. 5: the + form where p_i >= 0, the - form where p_i < 0 (tensile on) */
+    const int plus = !tensile || Pi >= 0;
+    const real Wdx = rhod_Wq(kern, dx[i] * iR) * iR * iR; /* W(dx), paper 000 Eq. 6 */
+    const real nxi = surface ? nrm[2 * i] : 0, nyi = surface ? nrm[2 * i + 1] : 0;
+    const int reli = nxi != 0 || nyi != 0;
+    real dr_div = 0, dr_dif = 0, apx = 0, apy = 0, avx = 0, avy = 0, kn = 0, kd = 0;
+    real sx = 0, sy = 0, fx = 0, fy = 0;
+    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
+      const real rx = xi - x[j], ry = yi - y[j], r2 = rx * rx + ry * ry;
+      if (!(r2 < R2 && r2 > 0))
+        continue;
+      const real r = sqrt(r2), q = r * iR;
+      const real dW = rhod_dWq(kern, q) * iR * iR * iR, dWr = dW / r;
+      const real gwx = dWr * rx, gwy = dWr * ry; /* grad W_ij */
+      const int pj = ph[j];
+      const real Vj = V[j], rhoj = rho[j];
+      const real uijx = uxi - ux[j], uijy = uyi - uy[j];
+      /* paper 000 Eq. 1, first sum: rho_i (u_i - u_j) . grad W_ij V_j (all phases) */
+      dr_div += rhod_mp_div_term(rhoi, uijx * gwx + uijy * gwy, Vj);
+      /* paper 000 Eq. 1, delta-SPH diffusion: the same phase only */
+      if (pj == pi)
+        dr_dif += rhod_mp_diffusion(delta, ci, rhoi, rhoj, dW, Vj);
+      /* paper 000 Eq. 2 (paper 001 Eq. 5): -(p_j +- p_i) V_j / rho_i grad W_ij */
+      const real pc = rhod_mp_press_coef(Pi, P[j], Vj, rhoi, plus);
+      apx += pc * gwx;
+      apy += pc * gwy;
+      if (visc) { /* paper 001 Eq. 6, all phases */
+        const real nuj = T[RHOD_MP_TAB_MU * MAXP + pj] / rhoj;
+        const real vc =
+            rhod_mp_visc_coef(mass[j], nui, nuj, rhoi, rhoj, uijx * rx + uijy * ry, r2, eta2h);
+        avx += vc * gwx;
+        avy += vc * gwy;
+      }
+      if (reli) { /* paper 001 Eq. 10 over the neighbours with a reliable normal */
+        const real nxj = nrm[2 * j], nyj = nrm[2 * j + 1];
+        if (nxj != 0 || nyj != 0) {
+          kn += Vj * ((nxi - nxj) * gwx + (nyi - nyj) * gwy);
+          kd += Vj * r * fabs(dW); /* D_i: the scalar (001 Eq. 10's TYPO prints a vector) */
+        }
+      }
+      /* paper 000 Eq. 7: sum_j V_j (1 + f_ij) grad W_ij, f_ij of Eq. 6 ... */
+      const real f = rhod_mp_rep(xi_rep, rhod_Wq(kern, q) * iR * iR, Wdx, rep_n);
+      sx += Vj * (1 + f) * gwx;
+      sy += Vj * (1 + f) * gwy;
+      if (pj != pi) { /* ... and the RIF's sum over j not in chi_i */
+        fx += Vj * gwx;
+        fy += Vj * gwy;
+      }
+    }
+    RHOD_END_NEIGHBOURS
+    drho[i] = dr_div + dr_dif;
+    real ax = apx + avx + gxb, ay = apy + avy + gyb;
+    if (surface) {
+      real kap_i = 0;
+      if (reli && kd > 0) {
+        kap_i = -RHOD_DIM * kn / kd; /* paper 001 Eq. 10 */
+        /* paper 001 Eq. 7 with n |grad C| = grad C: a = -(1/rho_i) sigma kappa grad C */
+        const real s = -sig[i] * kap_i / rhoi;
+        ax += s * gC[2 * i];
+        ay += s * gC[2 * i + 1];
+      }
+      kap[i] = kap_i;
+    }
+    acc[2 * i] = ax;
+    acc[2 * i + 1] = ay;
+    /* paper 000 Eqs. 4 and 7: x moves with u + u_s */
+    const real usx = rhod_mp_shift(xi_shift, h, dt, sx + xi_rif * alpha * fx);
+    const real usy = rhod_mp_shift(xi_shift, h, dt, sy + xi_rif * alpha * fy);
+    us[2 * i] = usx;
+    us[2 * i + 1] = usy;
+    vel[2 * i] = uxi + usx;
+    vel[2 * i + 1] = uyi + usy;
+  }
+}
+
+void rhod_mp_rhs(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt) {
+  if (m->surface)
+    rhod_mp_pass_colour(m, p, c);
+  rhod_mp_pass_main(m, p, c, dt);
+  /* the largest shift per step in particle sizes (logged; multiphase.md: no cap) */
+  const long n = (long)p->n;
+  const real *us = m->us, *dx = p->dx;
+  real umax = 0;
+  RHOD_KERNEL_LOOP_REDUCE(max, umax)
+  for (long i = 0; i < n; i++) {
+    const real u = sqrt(us[2 * i] * us[2 * i] + us[2 * i + 1] * us[2 * i + 1]) / dx[i];
+    umax = u > umax ? u : umax;
+  }
+  m->us_max = umax * (dt > 0 ? dt : 0);
+}
+
+/* Paper 001 Eqs. 14-17, per particle, with h_s = hs_fac R_i:
+ * 14: C_tau h_s^2 rho_i / mu_i, 15: C_a sqrt(h_s / |a_i|), 16: C_c h_s / c_i,
+ * 17: C_sigma sqrt(h_s^3 rho_i / (2 pi sigma)), sigma the largest of i's phase's pairs. */
+real rhod_mp_dt(rhod_mp *m, const rhod_particles *p) {
+  const long n = (long)p->n;
+  const real *dx = p->dx, *rho = p->rho, *acc = m->acc, *T = m->tab;
+  const uint8_t *ph = p->phase;
+  const real hsR = m->hs_fac * m->prm.ratio;
+  const real cv = m->prm.cfl_visc, ca = m->prm.cfl_force, cc = m->prm.cfl, cs = m->prm.cfl_surface;
+  real d14 = BIG, d17 = BIG, d15 = BIG, d16 = BIG;
+  RHOD_KERNEL_LOOP_REDUCE2(min, d14, d17)
+  for (long i = 0; i < n; i++) {
+    const int k = ph[i];
+    const real hs = hsR * dx[i], mu = T[RHOD_MP_TAB_MU * MAXP + k];
+    const real sg = T[RHOD_MP_TAB_SIGMA_MAX * MAXP + k];
+    const real a = mu > 0 ? cv * hs * hs * rho[i] / mu : BIG; /* Eq. 14 */
+    const real b = sg > 0 ? cs * sqrt(hs * hs * hs * rho[i] / (2 * RHOD_PI * sg)) : BIG; /* 17 */
+    d14 = a < d14 ? a : d14;
+    d17 = b < d17 ? b : d17;
+  }
+  RHOD_KERNEL_LOOP_REDUCE2(min, d15, d16)
+  for (long i = 0; i < n; i++) {
+    const real hs = hsR * dx[i];
+    const real am = sqrt(acc[2 * i] * acc[2 * i] + acc[2 * i + 1] * acc[2 * i + 1]);
+    const real a = am > 0 ? ca * sqrt(hs / am) : BIG;         /* Eq. 15 */
+    const real b = cc * hs / T[RHOD_MP_TAB_C * MAXP + ph[i]]; /* Eq. 16 */
+    d15 = a < d15 ? a : d15;
+    d16 = b < d16 ? b : d16;
+  }
+  real dt = d14;
+  m->dt_by = RHOD_MP_DT_VISC;
+  if (d15 < dt)
+    dt = d15, m->dt_by = RHOD_MP_DT_FORCE;
+  if (d16 < dt)
+    dt = d16, m->dt_by = RHOD_MP_DT_SOUND;
+  if (d17 < dt)
+    dt = d17, m->dt_by = RHOD_MP_DT_SURFACE;
+  return dt;
+}
