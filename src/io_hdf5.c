@@ -233,6 +233,8 @@ static int write_particles(h5_reason *R, hid_t file, const rhod_snapshot_view *v
     rc = write_dataset(R, g, "ParticleIDs", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 0, v->id, "1");
   if (!rc && v->fs)
     rc = write_dataset(R, g, "FreeSurface", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, v->fs, "1");
+  if (!rc && v->phase)
+    rc = write_dataset(R, g, "Phase", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, v->phase, "1");
   return close_group(R, g, rc);
 }
 
@@ -983,6 +985,14 @@ static int read_all(reader *r, rhod_snapshot_data *out) {
     }
     rc = read_dataset(r, "FreeSurface", n, 0, H5T_NATIVE_UINT8, out->fs);
   }
+  if (!rc && H5Lexists(r->file, "/PartType0/Phase", H5P_DEFAULT) > 0) {
+    out->phase = malloc(nn);
+    if (!out->phase) {
+      set_err(r->err, r->errlen, "%s: out of memory reading %zu particles", r->path, n);
+      return RHOD_ERR_MEMORY;
+    }
+    rc = read_dataset(r, "Phase", n, 0, H5T_NATIVE_UINT8, out->phase);
+  }
   H5Eclear2(H5E_DEFAULT);
   if (!rc)
     rc = read_params(r, &out->params);
@@ -1044,6 +1054,7 @@ void rhod_snapshot_data_free(rhod_snapshot_data *d) {
   free(d->size);
   free(d->id);
   free(d->fs);
+  free(d->phase);
   for (unsigned i = 0; i < d->params.n; i++) {
     free(d->params.keys[i]);
     free(d->params.values[i]);

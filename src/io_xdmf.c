@@ -19,7 +19,7 @@
 #include <string.h>
 
 unsigned rhod_snapshot_fields(const rhod_snapshot_view *v) {
-  return v && v->fs ? RHOD_FIELDS_FREE_SURFACE : 0u;
+  return (v && v->fs ? RHOD_FIELDS_FREE_SURFACE : 0u) | (v && v->phase ? RHOD_FIELDS_PHASE : 0u);
 }
 
 /* One DataItem pointing into a snapshot (path relative to the XDMF file). */
@@ -64,6 +64,8 @@ static void grid(FILE *f, int index, double time, size_t n, unsigned fields) {
   attribute(f, file, "ParticleID", "/PartType0/ParticleIDs", n, 0, "Int", 8);
   if (fields & RHOD_FIELDS_FREE_SURFACE)
     attribute(f, file, "FreeSurface", "/PartType0/FreeSurface", n, 0, "UChar", 1);
+  if (fields & RHOD_FIELDS_PHASE)
+    attribute(f, file, "Phase", "/PartType0/Phase", n, 0, "UChar", 1);
   fprintf(f, "      </Grid>\n");
 }
 

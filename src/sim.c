@@ -709,6 +709,10 @@ void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
   v->n = n;
   v->x = p->x, v->y = p->y, v->ux = p->ux, v->uy = p->uy, v->rho = p->rho;
   v->m = p->m, v->size = p->dx, v->id = p->id;
+  if (p->phase) { /* the phase tag, where a scheme has one */
+    rhod_to_host(p->phase, n);
+    v->phase = p->phase;
+  }
 }
 
 /* ---- warnings about the particles as set up -------------------------------------------- */

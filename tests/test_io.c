@@ -211,9 +211,23 @@ static void test_snapshot_minimal(void) {
                         RHOD_OK);
   CU_ASSERT_EQUAL(d.n, 4);
   CU_ASSERT_PTR_NULL(d.fs);
+  CU_ASSERT_PTR_NULL(d.phase);
   CU_ASSERT_EQUAL(d.params.n, 0);
   CU_ASSERT_EQUAL(d.p[3], (double)P.p[3]);
   rhod_snapshot_data_free(&d);
+
+  /* a multiphase scheme's phase tags: the Phase dataset, read back */
+  const uint8_t phase[4] = {0, 1, 7, 1};
+  v.phase = phase;
+  CU_ASSERT_EQUAL(rhod_snapshot_fields(&v), RHOD_FIELDS_PHASE);
+  CU_ASSERT_EQUAL_FATAL(rhod_write_snapshot(scratch, 15, &v, NULL, err, sizeof err), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_read_snapshot(spath("snapshot_0015.h5"), &d, err, sizeof err),
+                        RHOD_OK);
+  CU_ASSERT_PTR_NOT_NULL_FATAL(d.phase);
+  for (int i = 0; i < 4; i++)
+    CU_ASSERT_EQUAL(d.phase[i], phase[i]);
+  rhod_snapshot_data_free(&d);
+  v.phase = NULL;
 
   v.n = 0;
   CU_ASSERT_EQUAL_FATAL(rhod_write_snapshot(scratch, 13, &v, NULL, err, sizeof err), RHOD_OK);
@@ -356,6 +370,17 @@ static void test_xdmf(void) {
   CU_ASSERT_PTR_NOT_NULL_FATAL(s);
   CU_ASSERT_EQUAL(count_of(s, "<Grid "), 3);
   CU_ASSERT_PTR_NULL(strstr(s, "snapshot_0002.h5"));
+  free(s);
+
+  /* the optional fields: FreeSurface and Phase as UChar attributes */
+  CU_ASSERT_EQUAL(rhod_write_xdmf(scratch, 2, times, np,
+                                  RHOD_FIELDS_FREE_SURFACE | RHOD_FIELDS_PHASE, err, sizeof err),
+                  RHOD_OK);
+  s = slurp(path, NULL);
+  CU_ASSERT_PTR_NOT_NULL_FATAL(s);
+  CU_ASSERT_EQUAL(count_of(s, "Name=\"FreeSurface\""), 2);
+  CU_ASSERT_EQUAL(count_of(s, "Name=\"Phase\""), 2);
+  CU_ASSERT_EQUAL(count_of(s, "snapshot_0001.h5:/PartType0/Phase"), 1);
   free(s);
 
   char dir[4200];

@@ -90,8 +90,18 @@ static void free_particles(particles *P) {
 }
 
 static rhod_snapshot_view view_of(const particles *P, double t) {
-  rhod_snapshot_view v = {t,      P->n, P->x, P->y,    P->ux, P->uy,
-                          P->rho, P->p, P->m, P->size, P->id, P->fs};
+  rhod_snapshot_view v = {.time = t,
+                          .n = P->n,
+                          .x = P->x,
+                          .y = P->y,
+                          .ux = P->ux,
+                          .uy = P->uy,
+                          .rho = P->rho,
+                          .p = P->p,
+                          .m = P->m,
+                          .size = P->size,
+                          .id = P->id,
+                          .fs = P->fs};
   return v;
 }
 

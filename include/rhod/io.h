@@ -14,14 +14,15 @@
 typedef struct {
   double time;
   size_t n;
-  const real *x, *y;   /* positions [m] */
-  const real *ux, *uy; /* velocities [m/s] */
-  const real *rho;     /* density [kg/m^3] */
-  const real *p;       /* pressure [Pa] */
-  const real *m;       /* mass [kg/m] */
-  const real *size;    /* particle size dx_i [m] */
-  const uint64_t *id;  /* persistent particle id */
-  const uint8_t *fs;   /* free-surface flag (1: in F), may be NULL */
+  const real *x, *y;    /* positions [m] */
+  const real *ux, *uy;  /* velocities [m/s] */
+  const real *rho;      /* density [kg/m^3] */
+  const real *p;        /* pressure [Pa] */
+  const real *m;        /* mass [kg/m] */
+  const real *size;     /* particle size dx_i [m] */
+  const uint64_t *id;   /* persistent particle id */
+  const uint8_t *fs;    /* free-surface flag (1: in F), may be NULL */
+  const uint8_t *phase; /* phase index (the scene's phases, in order), may be NULL */
 } rhod_snapshot_view;
 
 /* Checks every value of v before it is written: positions, velocities and pressures
@@ -31,17 +32,17 @@ int rhod_snapshot_check(const rhod_snapshot_view *v, char *err, size_t errlen);
 
 /* OUT/snapshot_NNNN.h5: /Header attrs Time, Dimension (2), NumPart; /PartType0 datasets
  * Coordinates, Velocities (N x 3, z = 0), Densities, Pressures, Masses, ParticleSizes,
- * ParticleIDs, FreeSurface (if fs); /Mesh/Vertices (N x 1, 0..N-1: the XDMF vertex
- * cells); /Parameters/Keys and /Parameters/Values (variable-length strings, the dotted
- * keys in scene order, any number) and, up to 65535 keys, one string attribute per key
- * on /Parameters (dense storage, creation order tracked). Plain contiguous datasets, no filters.
- * Stored as double whatever the build precision. Every dataset has a string attribute Units:
- * Coordinates "m", Velocities "m/s", Densities "kg/m^3", Pressures "Pa", Masses "kg/m" (2D: per
- * unit depth), ParticleSizes "m", ParticleIDs, FreeSurface and Vertices "1", Keys and Values ""
- * (text). /Header also carries the strings Code ("rhod"), Precision (RHOD_REAL_NAME), CodeVersion
- * (rhod_version()) and GitCommit (rhod_commit()).
- * The file is built in memory, then written through rhod_write_bytes_atomic.
- * Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"), RHOD_ERR_MEMORY. */
+ * ParticleIDs, FreeSurface (if fs), Phase (if phase); /Mesh/Vertices (N x 1, 0..N-1: the XDMF
+ * vertex cells); /Parameters/Keys and /Parameters/Values (variable-length strings, the dotted keys
+ * in scene order, any number) and, up to 65535 keys, one string attribute per key on /Parameters
+ * (dense storage, creation order tracked). Plain contiguous datasets, no filters. Stored as double
+ * whatever the build precision. Every dataset has a string attribute Units: Coordinates "m",
+ * Velocities "m/s", Densities "kg/m^3", Pressures "Pa", Masses "kg/m" (2D: per unit depth),
+ * ParticleSizes "m", ParticleIDs, FreeSurface and Vertices "1", Keys and Values "" (text). /Header
+ * also carries the strings Code ("rhod"), Precision (RHOD_REAL_NAME), CodeVersion (rhod_version())
+ * and GitCommit (rhod_commit()). The file is built in memory, then written through
+ * rhod_write_bytes_atomic. Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"),
+ * RHOD_ERR_MEMORY. */
 int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
                         const rhod_param_list *params, char *err, size_t errlen);
 
@@ -54,6 +55,7 @@ typedef struct {
   double *x, *y, *ux, *uy, *rho, *p, *m, *size;
   uint64_t *id;
   uint8_t *fs;            /* FreeSurface, NULL when the file has none */
+  uint8_t *phase;         /* Phase, NULL when the file has none */
   rhod_param_list params; /* /Parameters (Keys and Values; in older files the attributes)
                              in file order; owned here, freed by
                              rhod_snapshot_data_free (not rhod_param_list_free) */
@@ -67,6 +69,7 @@ int rhod_read_snapshot_header(const char *path, double *time, uint64_t *n, char 
 
 /* Which optional datasets a snapshot of this view holds (bits below). */
 #define RHOD_FIELDS_FREE_SURFACE 1u
+#define RHOD_FIELDS_PHASE 2u
 unsigned rhod_snapshot_fields(const rhod_snapshot_view *v);
 
 /* OUT/snapshots.xdmf: a temporal collection of every snapshot written so far, as a
@@ -74,8 +77,8 @@ unsigned rhod_snapshot_fields(const rhod_snapshot_view *v);
  * XDMF readers and meshio's XdmfTimeSeriesReader get one vertex cell per particle, and
  * every field of the snapshot as a node attribute: Velocity, Density, Pressure, Mass,
  * ParticleSize, ParticleID and, when `fields` has RHOD_FIELDS_FREE_SURFACE (every
- * snapshot of a run has the same datasets), FreeSurface. Rewritten (atomically) after
- * each snapshot. */
+ * snapshot of a run has the same datasets), FreeSurface, with RHOD_FIELDS_PHASE, Phase.
+ * Rewritten (atomically) after each snapshot. */
 int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
                     unsigned fields, char *err, size_t errlen);
 
