@@ -1797,7 +1797,7 @@ static int load_wall_motion(lctx *c, const y_wall *y, unsigned i, rhod_wall *w,
                   v[0], v[1], user, a[0], a[1], b[0], b[1], i);
     /* the edge's normal (-ty, tx)/len along a periodic axis */
     for (int ax = 0; ax < 2; ax++)
-      if (periodic[ax] && fabs(ax ? tx : ty) <= 1e-9 * len)
+      if (periodic[ax] && fabs(ax ? ty : tx) <= 1e-9 * len)
         return fail(c, path,
                     "a wall velocity on a periodic axis: edge %u's normal lies along %c, "
                     "which domain.periodic wraps",

@@ -250,6 +250,26 @@ static void test_override_errors(void) {
       fprintf(stderr, "\n--set %s: rc %d, message '%s'\n", bad_overrides[i].set, rc, err);
     CU_ASSERT_TRUE(ok);
   }
+  /* on the three-phase scene */
+  const char *full[][3] = {
+      {"multiphase.sigma_pairs.0.sigma=-1", "multiphase.sigma_pairs.0.sigma", "must be >= 0"},
+      {"multiphase.sigma_pairs.1.phases=[water, gas]", "multiphase.sigma_pairs.1.phases.1",
+       "unknown phase 'gas' (phases: water, air, oil)"},
+      {"phases=[]", "phases", "expected at least 1 entry, got 0"},
+      {"walls.1.edges=[3]", "walls.1.edges.0", "the polygon has 3 edges"},
+  };
+  for (size_t i = 0; i < sizeof full / sizeof full[0]; i++) {
+    char err[1024] = "", want[512];
+    rhod_scene *s = (rhod_scene *)1;
+    const char *ov[] = {full[i][0]};
+    int rc = rhod_scene_load(GOOD("multiphase.yaml"), ov, 1, &s, err, sizeof err);
+    snprintf(want, sizeof want, "--set %s: %s: ", full[i][0], full[i][1]);
+    int ok =
+        rc == RHOD_ERR_SCENE && strncmp(err, want, strlen(want)) == 0 && strstr(err, full[i][2]);
+    if (!ok)
+      fprintf(stderr, "\n--set %s: rc %d, message '%s'\n", full[i][0], rc, err);
+    CU_ASSERT_TRUE(ok);
+  }
   /* the rhodsph scheme refuses the multiphase keys, from an override too */
   const char *rh[][2] = {
       {"phases.0={name: water, rho0: 1, c: 1}", "phases"},
