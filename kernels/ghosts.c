@@ -6,16 +6,18 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Mirrors of (x, y) in the walls within R: positions, Jacobians J and velocity
- * transforms T (row-major 2x2). Free slip: T = J (normal velocity reversed); no slip:
- * T = -I (both components reversed, wall at rest). Returns the count; with gx NULL it
+/* Mirrors of (x, y) in the walls within R: positions, Jacobians J, velocity transforms
+ * T (row-major 2x2) and the moving walls' part U of the ghost velocity u' = T u + U.
+ * Free slip: T = J (normal velocity reversed), U = 0 (a wall's motion along itself does
+ * not act on a free-slip fluid); no slip: T = -I (both components reversed), U = 2 u_wall,
+ * so that the mean of u and u' is the wall's velocity. Returns the count; with gx NULL it
  * only counts. The outputs are written straight into the ghost arrays (gx[k], J[4k]):
  * a local array here would sit in GCC 12's per-warp nvptx frame, shared by the 32
  * lanes of a simd loop, and the lanes would overwrite each other's mirrors
  * (tools/check_offload_frames.sh guards against any such array in a kernel). */
 static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner, int ncorner,
                                const real *circ, int ncirc, real x, real y, real R, real *gx,
-                               real *gy, real *J, real *T) {
+                               real *gy, real *J, real *T, real *U) {
   int n = 0;
   unsigned near = 0; /* bit s: mirrored in segment s (first 32 segments) */
   for (int s = 0; s < nseg && n < RHOD_MAX_GHOSTS_PER_PARTICLE; s++) {
@@ -30,16 +32,18 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     if (gx) {
       gx[n] = x - 2 * d * S[2];
       gy[n] = y - 2 * d * S[3];
-      real *Jn = J + 4 * n, *Tn = T + 4 * n;
+      real *Jn = J + 4 * n, *Tn = T + 4 * n, *Un = U + 2 * n;
       Jn[0] = 1 - 2 * S[2] * S[2];
       Jn[1] = -2 * S[2] * S[3];
       Jn[2] = Jn[1];
       Jn[3] = 1 - 2 * S[3] * S[3];
       if (S[7] != 0) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+        Un[0] = 2 * S[8], Un[1] = 2 * S[9];
       } else {
         for (int k = 0; k < 4; k++)
           Tn[k] = Jn[k];
+        Un[0] = 0, Un[1] = 0;
       }
     }
     n++;
@@ -67,16 +71,25 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       /* J = Jb Ja, each a reflection I - 2 e e^T (symmetric) */
       const real a0 = 1 - 2 * A[2] * A[2], a1 = -2 * A[2] * A[3], a3 = 1 - 2 * A[3] * A[3];
       const real b0 = 1 - 2 * B[2] * B[2], b1 = -2 * B[2] * B[3], b3 = 1 - 2 * B[3] * B[3];
-      real *Jn = J + 4 * n, *Tn = T + 4 * n;
+      real *Jn = J + 4 * n, *Tn = T + 4 * n, *Un = U + 2 * n;
       Jn[0] = b0 * a0 + b1 * a1;
       Jn[1] = b0 * a1 + b1 * a3;
       Jn[2] = b1 * a0 + b3 * a1;
       Jn[3] = b1 * a1 + b3 * a3;
       if (A[7] != 0 || B[7] != 0) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+        /* our choice (docs/choices.md "moving walls at corners"): with T = -I the corner
+         * ghost is a no-slip mirror of the corner, whose velocity is the mean of the
+         * no-slip walls meeting there (a free-slip wall imposes none): U = 2 u_corner.
+         * Composing the two mirrors, T_b (T_a u + U_a) + U_b, would give -U_a + U_b for
+         * two no-slip walls: the lid's velocity reversed at one of a cavity's corners */
+        const real na = A[7] != 0 ? 1 : 0, nb = B[7] != 0 ? 1 : 0;
+        Un[0] = 2 * (na * A[8] + nb * B[8]) / (na + nb);
+        Un[1] = 2 * (na * A[9] + nb * B[9]) / (na + nb);
       } else {
         for (int k = 0; k < 4; k++)
           Tn[k] = Jn[k];
+        Un[0] = 0, Un[1] = 0; /* T_b (T_a u + 0) + 0: free slip on both */
       }
     }
     n++;
@@ -98,7 +111,8 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       gx[n] = C[0] + rg * ex;
       gy[n] = C[1] + rg * ey;
       /* local mirror in the tangent line */
-      real *Jn = J + 4 * n, *Tn = T + 4 * n;
+      real *Jn = J + 4 * n, *Tn = T + 4 * n, *Un = U + 2 * n;
+      Un[0] = 0, Un[1] = 0; /* a circle does not move */
       Jn[0] = 1 - 2 * ex * ex;
       Jn[1] = -2 * ex * ey;
       Jn[2] = Jn[1];
@@ -132,7 +146,7 @@ void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real ratio
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++)
     near[i] = nseg + ncirc > 0 && wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i],
-                                               ratio * dx[i], NULL, NULL, NULL, NULL) > 0;
+                                               ratio * dx[i], NULL, NULL, NULL, NULL, NULL) > 0;
 }
 
 /* Phase 1: wall mirrors of the fluid. Returns the number of ghosts written or < 0. */
@@ -155,7 +169,7 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
         continue;
       }
       cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i], ratio * dx[i],
-                            NULL, NULL, NULL, NULL);
+                            NULL, NULL, NULL, NULL, NULL);
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)n + 1);
     if (total < 0)
@@ -166,6 +180,7 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       continue; /* the arrays moved: count again */
     }
     real *gxo = p->x, *gyo = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
+    real *gU = p->gU;
     int32_t *gsrc = p->gsrc;
     RHOD_KERNEL_LOOP
     for (long i = 0; i < n; i++) {
@@ -174,7 +189,7 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
         continue;
       const long base = n + cnt[i];
       wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, gxo[i], gyo[i], ratio * gdx[i],
-                   gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base);
+                   gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base, gU + 2 * base);
       for (long g = base; g < base + c; g++) {
         m[g] = m[i];
         gdx[g] = gdx[i];
@@ -230,6 +245,7 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
       return -2;
     }
     real *X = p->x, *Y = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
+    real *gU = p->gU;
     int32_t *gsrc = p->gsrc;
     RHOD_KERNEL_LOOP
     for (long k = 0; k < nsrc; k++) {
@@ -254,6 +270,7 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
             gJ[4 * g] = 1, gJ[4 * g + 1] = 0, gJ[4 * g + 2] = 0, gJ[4 * g + 3] = 1;
             gT[4 * g] = 1, gT[4 * g + 1] = 0, gT[4 * g + 2] = 0, gT[4 * g + 3] = 1;
             ge[2 * g] = 0, ge[2 * g + 1] = 0;
+            gU[2 * g] = 0, gU[2 * g + 1] = 0;
           } else {
             gsrc[g] = gsrc[k];
             for (int q = 0; q < 4; q++) {
@@ -261,6 +278,7 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
               gT[4 * g + q] = gT[4 * k + q];
             }
             ge[2 * g] = ge[2 * k], ge[2 * g + 1] = ge[2 * k + 1];
+            gU[2 * g] = gU[2 * k], gU[2 * g + 1] = gU[2 * k + 1];
           }
           g++;
         }

@@ -5,8 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Edge k (pt[k] to pt[k + 1]) moves at vel when bit k of `moving` is set. */
 static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
-                        const double (*pt)[2], unsigned np, int fluid_inside, int noslip) {
+                        const double (*pt)[2], unsigned np, int fluid_inside, int noslip,
+                        const double vel[2], unsigned moving) {
   /* orientation: signed area > 0 for counter-clockwise */
   double area = 0;
   for (unsigned k = 0; k < np; k++) {
@@ -34,6 +36,9 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
     S[5] = (real)(ty / len);
     S[6] = (real)len;
     S[7] = (real)noslip;
+    const int moves = k < 32 && ((moving >> k) & 1u);
+    S[8] = moves ? (real)vel[0] : 0;
+    S[9] = moves ? (real)vel[1] : 0;
     (*nseg)++;
   }
   /* corners: edge k ends where edge k+1 starts; the fluid wedge there is narrower
@@ -70,12 +75,12 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
     if (W->shape.kind == RHOD_SHAPE_RECT) {
       const double *m = W->shape.min, *M = W->shape.max;
       const double pts[4][2] = {{m[0], m[1]}, {M[0], m[1]}, {M[0], M[1]}, {m[0], M[1]}};
-      st =
-          push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner, pts, 4, W->fluid_inside, noslip);
+      st = push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner, pts, 4, W->fluid_inside, noslip,
+                        W->velocity, W->moving_edges);
     } else if (W->shape.kind == RHOD_SHAPE_POLYGON) {
       st = push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner,
                         (const double(*)[2])W->shape.points, W->shape.n_points, W->fluid_inside,
-                        noslip);
+                        noslip, W->velocity, W->moving_edges);
     } else {
       real *c = realloc(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)(b->ncirc + 1));
       if (!c)
@@ -92,6 +97,8 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
     if (st != RHOD_OK)
       return st;
   }
+  for (int k = 0; k < b->nseg; k++)
+    b->moving |= b->seg[RHOD_SEG_STRIDE * k + 8] != 0 || b->seg[RHOD_SEG_STRIDE * k + 9] != 0;
   rhod_dev_map(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
   rhod_dev_map(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
   rhod_dev_map(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);

@@ -71,6 +71,7 @@ int rhod_particles_init(rhod_particles *p, size_t cap) {
   ADD("gsrc", gsrc, sizeof(int32_t), 0);
   ADD("gJ", gJ, 4 * sizeof(real), 0);
   ADD("gT", gT, 4 * sizeof(real), 0);
+  ADD("gU", gU, 2 * sizeof(real), 0);
   ADD("ge", ge, 2 * sizeof(real), 0);
   ADD("perm", perm, sizeof(int32_t), 0);
 #undef ADD

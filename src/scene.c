@@ -13,6 +13,8 @@
 #include "rhod/scene.h"
 #include "rhod/io.h"
 
+#include "multiphase/scene_mp.h"
+#include "scene_module.h"
 #include "scene_yaml.h"
 
 #include <cyaml/cyaml.h>
@@ -63,6 +65,7 @@ typedef struct {
   int *pressure;
   double *surface;
   y_initial *initial;
+  char *phase;
 } y_fluid;
 
 typedef struct {
@@ -72,6 +75,9 @@ typedef struct {
   unsigned n_polygon;
   int *slip;
   bool *fluid_inside;
+  double *velocity;
+  double *edges;
+  unsigned n_edges;
 } y_wall;
 
 typedef struct {
@@ -92,12 +98,13 @@ typedef struct {
 
 typedef struct {
   double *rho0;
-  double c0;
+  double *c0;
   double *mu;
   double *gravity;
 } y_physics;
 
 typedef struct {
+  int *name;
   bool *riemann, *reconstruction, *shifting;
   double *shifting_a, *shifting_b, *shifting_eps;
   bool *acoustic_damper;
@@ -200,6 +207,9 @@ typedef struct {
   y_probes *probes;
   y_output *output;
   y_refinement *refinement;
+  y_mp_phase *phases; /* the multiphase scheme's sections (src/multiphase/scene_mp.c) */
+  unsigned n_phases;
+  y_mp_section *multiphase;
 } y_doc;
 
 /* ---- the schema ------------------------------------------------------------------------ */
@@ -229,6 +239,11 @@ static const cyaml_strval_t kernel_names[] = {
 static const cyaml_strval_t integrator_names[] = {
     {"rk4", RHOD_INTEGRATOR_RK4},
     {"rk2", RHOD_INTEGRATOR_RK2},
+    {"midpoint", RHOD_INTEGRATOR_MIDPOINT},
+};
+static const cyaml_strval_t scheme_names[] = {
+    {"rhodsph", RHOD_SCHEME_RHODSPH},
+    {"multiphase", RHOD_SCHEME_MULTIPHASE},
 };
 static const cyaml_strval_t init_names[] = {
     {"uniform", RHOD_INIT_UNIFORM},
@@ -292,12 +307,17 @@ static const cyaml_schema_field_t f_particles[] = {
     CYAML_FIELD_END,
 };
 
+/* physics.c0 is required for rhodsph only (convert) */
 static const cyaml_schema_field_t f_physics[] = {
-    NUM_OPT("rho0", y_physics, rho0),        NUM("c0", y_physics, c0), NUM_OPT("mu", y_physics, mu),
-    VEC("gravity", OPT, y_physics, gravity), CYAML_FIELD_END,
+    NUM_OPT("rho0", y_physics, rho0),
+    NUM_OPT("c0", y_physics, c0),
+    NUM_OPT("mu", y_physics, mu),
+    VEC("gravity", OPT, y_physics, gravity),
+    CYAML_FIELD_END,
 };
 
 static const cyaml_schema_field_t f_scheme[] = {
+    ENUM_OPT("name", y_scheme, name, scheme_names),
     BOOL_OPT("riemann", y_scheme, riemann),
     BOOL_OPT("reconstruction", y_scheme, reconstruction),
     BOOL_OPT("shifting", y_scheme, shifting),
@@ -367,6 +387,7 @@ static const cyaml_schema_field_t f_fluid[] = {
     ENUM_OPT("pressure", y_fluid, pressure, init_names),
     NUM_OPT("surface", y_fluid, surface),
     CYAML_FIELD_MAPPING_PTR("initial", OPT, y_fluid, initial, f_initial),
+    CYAML_FIELD_STRING_PTR("phase", OPT, y_fluid, phase, 1, NAME_MAX_LEN),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_fluid = {
@@ -376,6 +397,9 @@ static const cyaml_schema_field_t f_wall[] = {
     SHAPE_FIELDS(y_wall),
     ENUM_OPT("slip", y_wall, slip, slip_names),
     BOOL_OPT("fluid_inside", y_wall, fluid_inside),
+    VEC("velocity", OPT, y_wall, velocity),
+    CYAML_FIELD_SEQUENCE_COUNT("edges", OPT | CYAML_FLAG_FLOW, y_wall, edges, n_edges, &sch_float,
+                               1, CYAML_UNLIMITED),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_wall = {
@@ -474,7 +498,8 @@ static const cyaml_schema_field_t f_doc[] = {
     CYAML_FIELD_STRING_PTR("name", OPT, y_doc, name, 1, NAME_MAX_LEN),
     CYAML_FIELD_MAPPING("time", CYAML_FLAG_DEFAULT, y_doc, time, f_time),
     CYAML_FIELD_MAPPING("particles", CYAML_FLAG_DEFAULT, y_doc, particles, f_particles),
-    CYAML_FIELD_MAPPING("physics", CYAML_FLAG_DEFAULT, y_doc, physics, f_physics),
+    /* required for rhodsph (convert): the multiphase scheme may leave it out */
+    CYAML_FIELD_MAPPING("physics", CYAML_FLAG_OPTIONAL, y_doc, physics, f_physics),
     CYAML_FIELD_MAPPING_PTR("scheme", OPT, y_doc, scheme, f_scheme),
     CYAML_FIELD_MAPPING_PTR("domain", OPT, y_doc, domain, f_domain),
     CYAML_FIELD_SEQUENCE_COUNT("fluid", CYAML_FLAG_POINTER, y_doc, fluid, n_fluid, &sch_fluid, 1,
@@ -483,6 +508,9 @@ static const cyaml_schema_field_t f_doc[] = {
     CYAML_FIELD_MAPPING_PTR("probes", OPT, y_doc, probes, f_probes),
     CYAML_FIELD_MAPPING_PTR("output", OPT, y_doc, output, f_output),
     CYAML_FIELD_MAPPING_PTR("refinement", OPT, y_doc, refinement, f_refinement),
+    CYAML_FIELD_SEQUENCE_COUNT("phases", OPT, y_doc, phases, n_phases, &rhod_mp_sch_phase, 1,
+                               RHOD_MP_MAX_PHASES),
+    CYAML_FIELD_MAPPING_PTR("multiphase", OPT, y_doc, multiphase, rhod_mp_f_section),
     CYAML_FIELD_END,
 };
 
@@ -490,7 +518,7 @@ static const cyaml_schema_value_t sch_doc = {CYAML_VALUE_MAPPING(CYAML_FLAG_POIN
 
 /* ---- loading context and messages ------------------------------------------------------ */
 
-typedef struct {
+struct lctx {
   const char *file;
   const char *const *ov;
   int n_ov;
@@ -498,7 +526,7 @@ typedef struct {
   char *err;
   size_t errlen;
   int picture_off; /* output.picture: false */
-} lctx;
+};
 
 /* Every message is one line: the control characters of the user's text it quotes (keys,
  * values, overrides, the file's path) are written as \n, \t, \r or \xNN. */
@@ -601,6 +629,42 @@ static int fail_oom(lctx *c) {
 
 static void node_path(const ry_node *n, char *buf, size_t len) { ry_path(n, buf, len); }
 
+/* "path.key: missing required key", reported at the key naming the mapping at `path` (the
+ * document's start for the top level), as libcyaml's missing keys are (cyaml_failure). */
+static int fail_missing(lctx *c, const char *path, const char *key, const char *why) {
+  const ry_node *m = path[0] ? ry_find_path(c->root, path) : c->root;
+  const ry_node *where =
+      m && m->parent && m->parent->kind == RY_MAP ? m->parent->keys[m->index] : m;
+  char want[256];
+  snprintf(want, sizeof want, "%s%s%s", path, path[0] ? "." : "", key);
+  return fail_at(c, where, want, "missing required key%s%s%s", why ? " (" : "", why ? why : "",
+                 why ? ")" : "");
+}
+
+/* ---- the loader's mechanism lent to the scheme modules (scene_module.h) ---------------- */
+
+int rhod_sl_fail(lctx *c, const char *path, const char *fmt, ...) {
+  const ry_node *n = ry_find_path(c->root, path);
+  va_list ap;
+  va_start(ap, fmt);
+  int rc = vfail_at(c, n, path, fmt, ap);
+  va_end(ap);
+  return rc;
+}
+
+int rhod_sl_fail_missing(lctx *c, const char *path, const char *key, const char *why) {
+  return fail_missing(c, path, key, why);
+}
+
+int rhod_sl_fail_oom(lctx *c) { return fail_oom(c); }
+
+int rhod_sl_identifier(const char *s) {
+  static const char alpha[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ_";
+  if (!s || !s[0] || !strchr(alpha, s[0]) || strlen(s) > NAME_MAX_LEN)
+    return 0;
+  return strspn(s, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") == strlen(s);
+}
+
 /* ---- schema helpers -------------------------------------------------------------------- */
 
 static int is_seq_schema(const cyaml_schema_value_t *s) {
@@ -641,7 +705,9 @@ static void describe_schema(const cyaml_schema_value_t *s, char *buf, size_t len
     break;
   case CYAML_SEQUENCE_FIXED:
     snprintf(buf, len, "a list of %u %s", (unsigned)s->sequence.max,
-             s->sequence.entry->type == CYAML_BOOL ? "booleans" : "numbers");
+             s->sequence.entry->type == CYAML_BOOL     ? "booleans"
+             : s->sequence.entry->type == CYAML_STRING ? "names"
+                                                       : "numbers");
     break;
   case CYAML_SEQUENCE:
     snprintf(buf, len, "a list");
@@ -1543,14 +1609,22 @@ static int check_limits(lctx *c, rhod_scene *s) {
                   s->picture_box_set ? "box" : "domain", ex, ey, panels == 2 ? ", two panels" : "",
                   RHOD_PICTURE_MAX_SIDE);
   }
-  /* time: every step is at most Eq. 11's acoustic bound at the coarsest size */
-  const double dt_max = s->cfl * s->radius_ratio * s->dx / s->c0;
+  /* time: every step is at most the acoustic bound at the coarsest size: Eq. 11 of paper
+   * 002 for rhodsph, paper 001 Eq. 16 (h_s < R) with the fastest phase for multiphase */
+  double c_max = s->c0, cfl = s->cfl;
+  if (s->mp) {
+    cfl = s->mp->cfl;
+    c_max = 0;
+    for (unsigned k = 0; k < s->mp->n_phases; k++)
+      c_max = fmax(c_max, s->mp->phases[k].c);
+  }
+  const double dt_max = cfl * s->radius_ratio * s->dx / c_max;
   const double steps = s->t_end / dt_max;
   if (!(steps <= RHOD_MAX_STEPS))
     return fail(c, "time.end",
-                "%g s needs at least %.3g steps (dt <= cfl R/c0 = %.3g s, Eq. 11), more than "
+                "%g s needs at least %.3g steps (dt <= cfl R/c0 = %.3g s, %s), more than "
                 "%.0e: in double precision t + dt would keep too few of dt's digits",
-                s->t_end, steps, dt_max, RHOD_MAX_STEPS);
+                s->t_end, steps, dt_max, s->mp ? "paper 001 Eq. 16" : "Eq. 11", RHOD_MAX_STEPS);
   const double snaps = s->t_end / s->output_every;
   if (!(snaps <= RHOD_MAX_SNAPSHOTS))
     return fail(c, "time.output_every",
@@ -1578,16 +1652,186 @@ static int check_limits(lctx *c, rhod_scene *s) {
   return RHOD_OK;
 }
 
+/* ---- the two schemes' keys ------------------------------------------------------------- */
+
+/* Keys of the rhodsph scheme (paper 002) that a multiphase scene refuses: the scheme's
+ * switches, refinement (APR), its single fluid's state law and viscosity, the initial
+ * relaxation, and its time step (Eq. 11 and the RK4 stiffness limit; the multiphase
+ * scheme has multiphase.cfl*). */
+static int rhod_only(const char *section, const char *key) {
+  if (strcmp(section, "scheme") == 0)
+    return strcmp(key, "name") != 0;
+  if (strcmp(section, "refinement") == 0)
+    return 1;
+  if (strcmp(section, "physics") == 0)
+    return strcmp(key, "rho0") == 0 || strcmp(key, "c0") == 0 || strcmp(key, "mu") == 0;
+  if (strcmp(section, "particles") == 0)
+    return strncmp(key, "relax", 5) == 0;
+  if (strcmp(section, "time") == 0)
+    return strcmp(key, "stiffness_limit") == 0 || strcmp(key, "cfl") == 0 ||
+           strcmp(key, "cfl_visc") == 0;
+  return 0;
+}
+
+/* Where a key's error points: the key in the file, or the override that set its value. */
+static const ry_node *key_at(const ry_node *map, unsigned j) {
+  return map->items[j]->origin >= 0 ? map->items[j] : map->keys[j];
+}
+
+/* The first key, in document order, that belongs to the other scheme. */
+static int refuse_other_scheme(lctx *c, rhod_scheme_kind scheme) {
+  const ry_node *r = c->root;
+  char path[600];
+  for (unsigned i = 0; r->kind == RY_MAP && i < r->n; i++) {
+    const char *sec = r->keys[i]->text;
+    const ry_node *m = r->items[i];
+    if (scheme == RHOD_SCHEME_RHODSPH) {
+      if (strcmp(sec, "phases") == 0 || strcmp(sec, "multiphase") == 0)
+        return fail_at(c, key_at(r, i), sec,
+                       "belongs to the multiphase scheme (scheme.name: multiphase)");
+      for (unsigned k = 0; strcmp(sec, "fluid") == 0 && m->kind == RY_SEQ && k < m->n; k++) {
+        const ry_node *b = m->items[k];
+        for (unsigned j = 0; b->kind == RY_MAP && j < b->n; j++)
+          if (strcmp(b->keys[j]->text, "phase") == 0) {
+            snprintf(path, sizeof path, "fluid.%u.phase", k);
+            return fail_at(c, key_at(b, j), path,
+                           "belongs to the multiphase scheme (scheme.name: multiphase)");
+          }
+      }
+      continue;
+    }
+    if (strcmp(sec, "refinement") == 0 && (m->kind != RY_MAP || m->n == 0))
+      return fail_at(c, key_at(r, i), sec,
+                     "belongs to the rhodsph scheme, not to scheme.name: multiphase");
+    for (unsigned j = 0; m->kind == RY_MAP && j < m->n; j++)
+      if (rhod_only(sec, m->keys[j]->text)) {
+        snprintf(path, sizeof path, "%s.%s", sec, m->keys[j]->text);
+        return fail_at(c, key_at(m, j), path,
+                       "belongs to the rhodsph scheme, not to scheme.name: multiphase");
+      }
+  }
+  return RHOD_OK;
+}
+
+/* Edge j of a wall's shape in the stored order (rect: bottom, right, top, left, as
+ * src/boundary.c builds them; polygon: points[j] to points[j + 1], counter-clockwise). */
+static void wall_edge(const rhod_shape *sh, unsigned j, double a[2], double b[2]) {
+  if (sh->kind == RHOD_SHAPE_RECT) {
+    const double pts[4][2] = {{sh->min[0], sh->min[1]},
+                              {sh->max[0], sh->min[1]},
+                              {sh->max[0], sh->max[1]},
+                              {sh->min[0], sh->max[1]}};
+    memcpy(a, pts[j], sizeof pts[j]);
+    memcpy(b, pts[(j + 1) % 4], sizeof pts[j]);
+  } else {
+    memcpy(a, sh->points[j], sizeof sh->points[j]);
+    memcpy(b, sh->points[(j + 1) % sh->n_points], sizeof sh->points[j]);
+  }
+}
+
+/* walls.N.velocity and walls.N.edges: which edges move, each along itself. Polygon edge
+ * indices are the file's; a polygon written clockwise is stored reversed, its edge k
+ * (points k to k + 1) then being stored edge n - 2 - k (mod n). */
+static int load_wall_motion(lctx *c, const y_wall *y, unsigned i, rhod_wall *w,
+                            const int periodic[2]) {
+  char path[160];
+  if (!y->velocity && !y->edges)
+    return RHOD_OK;
+  if (w->shape.kind == RHOD_SHAPE_CIRCLE) {
+    snprintf(path, sizeof path, "walls.%u.%s", i, y->velocity ? "velocity" : "edges");
+    return fail(c, path, "a circle wall cannot move (only the edges of a rect or polygon)");
+  }
+  const unsigned ne = w->shape.kind == RHOD_SHAPE_RECT ? 4 : w->shape.n_points;
+  const int reversed = w->shape.kind == RHOD_SHAPE_POLYGON &&
+                       polygon_area((const double(*)[2])y->polygon, y->n_polygon) < 0;
+  if (y->velocity)
+    memcpy(w->velocity, y->velocity, sizeof w->velocity);
+  const int moves = w->velocity[0] != 0 || w->velocity[1] != 0;
+  unsigned bits = 0;
+  for (unsigned k = 0; k < (y->edges ? y->n_edges : 0); k++) {
+    const double e = y->edges[k];
+    snprintf(path, sizeof path, "walls.%u.edges.%u", i, k);
+    if (!(e >= 0 && e == floor(e)))
+      return fail(c, path, "must be a whole edge index, got %g", e);
+    if (e >= ne)
+      return w->shape.kind == RHOD_SHAPE_RECT
+                 ? fail(c, path,
+                        "edge %g out of range: a rect has 4 edges (0 bottom, 1 right, 2 top, "
+                        "3 left)",
+                        e)
+                 : fail(c, path,
+                        "edge %g out of range: the polygon has %u edges (0 to %u, edge k from "
+                        "point k to k + 1)",
+                        e, ne, ne - 1);
+    const unsigned j = reversed ? (2 * ne - 2 - (unsigned)e) % ne : (unsigned)e;
+    if (j >= 32 && moves)
+      return fail(c, path, "edge %g: only the first 32 edges of a polygon can move", e);
+    if (j < 32)
+      bits |= 1u << j;
+  }
+  if (!moves) /* at rest: nothing moves, whatever edges says */
+    return RHOD_OK;
+  if (!y->edges) {
+    if (ne > 32) {
+      snprintf(path, sizeof path, "walls.%u.velocity", i);
+      return fail(c, path,
+                  "a polygon of %u edges cannot move all of them (at most 32 edges move): "
+                  "name them in walls.%u.edges",
+                  ne, i);
+    }
+    bits = ne == 32 ? 0xffffffffu : (1u << ne) - 1;
+  }
+  snprintf(path, sizeof path, "walls.%u.velocity", i);
+  const double *v = w->velocity, speed = hypot(v[0], v[1]);
+  for (unsigned j = 0; j < ne; j++) {
+    if (!((bits >> j) & 1u))
+      continue;
+    double a[2], b[2];
+    wall_edge(&w->shape, j, a, b);
+    const double tx = b[0] - a[0], ty = b[1] - a[1], len = hypot(tx, ty);
+    const unsigned user = reversed ? (2 * ne - 2 - j) % ne : j;
+    if (fabs(tx * v[1] - ty * v[0]) > 1e-9 * len * speed)
+      return fail(c, path,
+                  "[%g, %g] is not along edge %u (from [%g, %g] to [%g, %g]): a moving edge "
+                  "slides along itself (name the moving edges in walls.%u.edges)",
+                  v[0], v[1], user, a[0], a[1], b[0], b[1], i);
+    /* the edge's normal (-ty, tx)/len along a periodic axis */
+    for (int ax = 0; ax < 2; ax++)
+      if (periodic[ax] && fabs(ax ? ty : tx) <= 1e-9 * len)
+        return fail(c, path,
+                    "a wall velocity on a periodic axis: edge %u's normal lies along %c, "
+                    "which domain.periodic wraps",
+                    user, ax ? 'y' : 'x');
+  }
+  w->moving_edges = bits;
+  return RHOD_OK;
+}
+
+int rhod_scene_walls_move(const rhod_scene *s) {
+  for (unsigned i = 0; s && i < s->n_walls; i++)
+    if (s->walls[i].moving_edges)
+      return 1;
+  return 0;
+}
+
 static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   char path[128];
+  /* the scheme first: it decides which keys belong, and some defaults */
+  s->scheme =
+      d->scheme && d->scheme->name ? (rhod_scheme_kind)*d->scheme->name : RHOD_SCHEME_RHODSPH;
+  const int mpx = s->scheme == RHOD_SCHEME_MULTIPHASE;
+  TRY(refuse_other_scheme(c, s->scheme));
+  if (mpx)
+    TRY(rhod_mp_load(c, d->phases, d->n_phases, d->multiphase, s));
   /* time */
   s->t_end = d->time.end;
   s->output_every = d->time.output_every;
   s->cfl = opt(d->time.cfl, 0.5);
   s->cfl_visc = opt(d->time.cfl_visc, 0.025);
-  s->integrator =
-      d->time.integrator ? (rhod_integrator_kind)*d->time.integrator : RHOD_INTEGRATOR_RK4;
-  s->stiffness_limit = opt_bool(d->time.stiffness_limit, 1);
+  s->integrator = d->time.integrator ? (rhod_integrator_kind)*d->time.integrator
+                  : mpx              ? RHOD_INTEGRATOR_MIDPOINT
+                                     : RHOD_INTEGRATOR_RK4;
+  s->stiffness_limit = !mpx && opt_bool(d->time.stiffness_limit, 1);
   TRY(check_positive(c, "time.end", s->t_end));
   TRY(check_positive(c, "time.output_every", s->output_every));
   TRY(check_range(c, "time.cfl", s->cfl, 0, 1, 1, 0));
@@ -1595,8 +1839,9 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   /* particles */
   s->dx = d->particles.dx;
   s->radius_ratio = opt(d->particles.radius_ratio, 4);
-  s->kernel =
-      d->particles.kernel ? (rhod_kernel_kind)*d->particles.kernel : RHOD_KERNEL_WENDLAND_C2;
+  s->kernel = d->particles.kernel ? (rhod_kernel_kind)*d->particles.kernel
+              : mpx               ? RHOD_KERNEL_WENDLAND_C4
+                                  : RHOD_KERNEL_WENDLAND_C2;
   TRY(check_positive(c, "particles.dx", s->dx));
   TRY(check_range(c, "particles.radius_ratio", s->radius_ratio, 2, 0, 8, 0));
   s->jitter = opt(d->particles.jitter, 0);
@@ -1610,16 +1855,22 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       d->particles.relax_where ? (rhod_relax_where)*d->particles.relax_where : RHOD_RELAX_ALL;
   if (d->particles.relax_where && s->relax == 0)
     return fail(c, "particles.relax_where", "needs particles.relax (iterations) above 0");
-  /* physics */
-  s->rho0 = opt(d->physics.rho0, 1000);
-  s->c0 = d->physics.c0;
-  s->mu = opt(d->physics.mu, 0);
+  /* physics: rho0, c0, mu are rhodsph's (the multiphase scheme's are its phases') */
   if (d->physics.gravity)
     memcpy(s->gravity, d->physics.gravity, sizeof s->gravity);
-  TRY(check_positive(c, "physics.rho0", s->rho0));
-  TRY(check_positive(c, "physics.c0", s->c0));
-  if (!(s->mu >= 0))
-    return fail(c, "physics.mu", "must be >= 0, got %g", s->mu);
+  if (!mpx) {
+    if (!(c->root->kind == RY_MAP && ry_map_get(c->root, "physics")))
+      return fail_missing(c, "", "physics", NULL);
+    if (!d->physics.c0)
+      return fail_missing(c, "physics", "c0", NULL);
+    s->rho0 = opt(d->physics.rho0, 1000);
+    s->c0 = *d->physics.c0;
+    s->mu = opt(d->physics.mu, 0);
+    TRY(check_positive(c, "physics.rho0", s->rho0));
+    TRY(check_positive(c, "physics.c0", s->c0));
+    if (!(s->mu >= 0))
+      return fail(c, "physics.mu", "must be >= 0, got %g", s->mu);
+  }
   /* scheme */
   const y_scheme *sc = d->scheme;
   static const y_scheme none = {0};
@@ -1694,6 +1945,9 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     const ry_node *bn = ry_find_path(c->root, path);
     if (bn && bn->origin < 0)
       b->line = bn->line, b->col = bn->col;
+    b->phase = -1;
+    if (mpx)
+      TRY(rhod_mp_fluid_phase(c, s, i, y->phase, &b->phase));
     if (y->surface) {
       char sp[160];
       snprintf(sp, sizeof sp, "%s.surface", path);
@@ -1760,6 +2014,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &w->shape));
     w->slip = y->slip ? (rhod_slip)*y->slip : RHOD_SLIP_FREE;
     w->fluid_inside = opt_bool(y->fluid_inside, 1);
+    TRY(load_wall_motion(c, y, i, w, s->periodic));
   }
   /* refinement (paper 002 Sec. V) */
   TRY(load_refinement(c, d->refinement, s));
@@ -1882,9 +2137,7 @@ static void fmt_num(double v, char *buf, size_t len) {
   }
 }
 
-typedef struct {
-  int oom;
-} tb;
+typedef rhod_sl_tb tb;
 
 static ry_node *tb_add(tb *t, ry_node *parent, const char *key, ry_node *n) {
   if (!n)
@@ -1954,6 +2207,19 @@ static void tb_vec(tb *t, ry_node *parent, const char *key, const double v[2]) {
   tb_num(t, seq, NULL, v[1]);
 }
 
+ry_node *rhod_sl_coll(rhod_sl_tb *t, ry_node *parent, const char *key, ry_kind kind, int flow) {
+  return tb_coll(t, parent, key, kind, flow);
+}
+void rhod_sl_num(rhod_sl_tb *t, ry_node *parent, const char *key, double v) {
+  tb_num(t, parent, key, v);
+}
+void rhod_sl_bool(rhod_sl_tb *t, ry_node *parent, const char *key, int v) {
+  tb_bool(t, parent, key, v);
+}
+void rhod_sl_word(rhod_sl_tb *t, ry_node *parent, const char *key, const char *v) {
+  tb_word(t, parent, key, v);
+}
+
 static void tb_shape(tb *t, ry_node *entry, const rhod_shape *sh) {
   ry_node *m;
   switch (sh->kind) {
@@ -1987,33 +2253,46 @@ static ry_node *scene_tree(const rhod_scene *s) {
   ry_node *root = tb_coll(&t, NULL, NULL, RY_MAP, 0), *m, *e;
   if (s->name)
     tb_word(&t, root, "name", s->name);
+  /* a multiphase scene has none of rhodsph's keys (refuse_other_scheme) */
+  const int mpx = s->scheme == RHOD_SCHEME_MULTIPHASE;
   m = tb_coll(&t, root, "time", RY_MAP, 0);
   tb_num(&t, m, "end", s->t_end);
   tb_num(&t, m, "output_every", s->output_every);
-  tb_num(&t, m, "cfl", s->cfl);
-  tb_num(&t, m, "cfl_visc", s->cfl_visc);
+  if (!mpx) {
+    tb_num(&t, m, "cfl", s->cfl);
+    tb_num(&t, m, "cfl_visc", s->cfl_visc);
+  }
   tb_word(&t, m, "integrator",
           strval_name(integrator_names, CYAML_ARRAY_LEN(integrator_names), (int)s->integrator));
-  if (!s->stiffness_limit) /* present only when off, so checkpoints made before the key resume */
+  if (!mpx && !s->stiffness_limit) /* present only when off, so checkpoints made before the
+                                      key resume */
     tb_bool(&t, m, "stiffness_limit", s->stiffness_limit);
   m = tb_coll(&t, root, "particles", RY_MAP, 0);
   tb_num(&t, m, "dx", s->dx);
   tb_num(&t, m, "radius_ratio", s->radius_ratio);
   tb_num(&t, m, "jitter", s->jitter);
-  if (s->relax > 0) /* absent at 0, so checkpoints made before the key resume */
+  if (!mpx && s->relax > 0) /* absent at 0, so checkpoints made before the key resume */
     tb_num(&t, m, "relax", s->relax);
-  if (s->relax_where != RHOD_RELAX_ALL) /* likewise absent at its default */
+  if (!mpx && s->relax_where != RHOD_RELAX_ALL) /* likewise absent at its default */
     tb_word(
         &t, m, "relax_where",
         strval_name(relax_where_names, CYAML_ARRAY_LEN(relax_where_names), (int)s->relax_where));
   tb_word(&t, m, "kernel",
           strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
   m = tb_coll(&t, root, "physics", RY_MAP, 0);
-  tb_num(&t, m, "rho0", s->rho0);
-  tb_num(&t, m, "c0", s->c0);
-  tb_num(&t, m, "mu", s->mu);
+  if (!mpx) {
+    tb_num(&t, m, "rho0", s->rho0);
+    tb_num(&t, m, "c0", s->c0);
+    tb_num(&t, m, "mu", s->mu);
+  }
   tb_vec(&t, m, "gravity", s->gravity);
   m = tb_coll(&t, root, "scheme", RY_MAP, 0);
+  if (mpx) { /* absent for rhodsph, its default, so checkpoints made before the key resume */
+    tb_word(&t, m, "name",
+            strval_name(scheme_names, CYAML_ARRAY_LEN(scheme_names), (int)s->scheme));
+    rhod_mp_tree(&t, root, s->mp);
+    goto domain;
+  }
   tb_bool(&t, m, "riemann", s->riemann);
   tb_bool(&t, m, "reconstruction", s->reconstruction);
   tb_bool(&t, m, "shifting", s->shifting);
@@ -2034,6 +2313,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
   tb_num(&t, m, "theta_threshold", s->theta_threshold);
   tb_word(&t, m, "viscosity",
           strval_name(viscosity_names, CYAML_ARRAY_LEN(viscosity_names), (int)s->viscosity));
+domain:
   m = tb_coll(&t, root, "domain", RY_MAP, 0);
   if (s->has_domain) {
     tb_vec(&t, m, "min", s->domain_min);
@@ -2051,6 +2331,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
             strval_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
     if (s->fluid[i].surface_set) /* absent at its default, so older checkpoints resume */
       tb_num(&t, e, "surface", s->fluid[i].surface);
+    if (mpx)
+      tb_word(&t, e, "phase", s->mp->phases[s->fluid[i].phase].name);
     const rhod_fluid_block *fb = &s->fluid[i];
     if (fb->flow != RHOD_FLOW_NONE) {
       ry_node *in = tb_coll(&t, e, "initial", RY_MAP, 0);
@@ -2072,6 +2354,14 @@ static ry_node *scene_tree(const rhod_scene *s) {
     tb_word(&t, e, "slip",
             strval_name(slip_names, CYAML_ARRAY_LEN(slip_names), (int)s->walls[i].slip));
     tb_bool(&t, e, "fluid_inside", s->walls[i].fluid_inside);
+    const rhod_wall *w = &s->walls[i];
+    if (w->moving_edges) { /* absent at rest, so older checkpoints resume */
+      tb_vec(&t, e, "velocity", w->velocity);
+      ry_node *edges = tb_coll(&t, e, "edges", RY_SEQ, 1);
+      for (unsigned k = 0; k < 32; k++)
+        if ((w->moving_edges >> k) & 1u)
+          tb_num(&t, edges, NULL, k);
+    }
   }
   m = tb_coll(&t, root, "probes", RY_MAP, 0);
   tb_num(&t, m, "every", s->probe_every);
@@ -2089,6 +2379,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
     if (p->kind == RHOD_PROBE_FRONT)
       tb_vec(&t, b, "direction", p->direction);
   }
+  if (mpx)
+    goto output;
   m = tb_coll(&t, root, "refinement", RY_MAP, 0);
   tb_num(&t, m, "levels", s->levels);
   tb_word(&t, m, "pattern",
@@ -2116,6 +2408,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
       tb_num(&t, e, "below", s->field_below);
     tb_num(&t, e, "from", s->field_from);
   }
+output:
   m = tb_coll(&t, root, "output", RY_MAP, 0);
   if (!s->picture_enabled) {
     tb_bool(&t, m, "picture", 0);
@@ -2155,6 +2448,7 @@ void rhod_scene_free(rhod_scene *s) {
   for (unsigned i = 0; i < s->n_regions; i++)
     free(s->regions[i].shape.points);
   free(s->regions);
+  rhod_mp_scene_free(s->mp);
   free(s->fluid);
   free(s->walls);
   free(s->probes);
@@ -2479,7 +2773,7 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
   }
   double du = sqrt(2 * g * H) + umax, dp = s->rho0 * g * H;
   double bound = 10 * fmax(du, s->rho0 > 0 ? sqrt(dp / s->rho0) : 0);
-  if (s->c0 < bound * (1 - 1e-12))
+  if (s->scheme == RHOD_SCHEME_RHODSPH && s->c0 < bound * (1 - 1e-12))
     rhod_warn(
         &w,
         "%s: physics.c0: %g m/s is below the bound %.4g m/s of paper 002 Eq. 2, "

@@ -3,8 +3,9 @@
  * are and how vectors map into them. Which values they carry (pressure with the
  * hydrostatic correction, mirrored gradients) is the scheme's business.
  *
- * A ghost g of fluid particle s: x_g = J x_s + c, velocity u_g = T u_s, and the
- * displacement e_g = x_g - x_s of its wall mirror (zero for pure periodic images). */
+ * A ghost g of fluid particle s: x_g = J x_s + c, velocity u_g = T u_s + U_g (U_g the
+ * moving wall's part, 0 where no wall moves), and the displacement e_g = x_g - x_s of
+ * its wall mirror (zero for pure periodic images). */
 #ifndef RHOD_BOUNDARY_H
 #define RHOD_BOUNDARY_H
 
@@ -13,7 +14,9 @@
 #include "rhod/scene.h"
 #include <math.h>
 
-#define RHOD_SEG_STRIDE 8  /* ax, ay, nx, ny, tx, ty, length, noslip */
+#define RHOD_SEG_STRIDE                                                                            \
+  10                       /* ax, ay, nx, ny, tx, ty, length, noslip, ux, uy (the edge's           \
+                              velocity along itself, walls.N.velocity; 0 at rest) */
 #define RHOD_CIRC_STRIDE 5 /* cx, cy, radius, side (+1 fluid inside, -1 outside), noslip */
 #define RHOD_MAX_GHOSTS_PER_PARTICLE 6
 
@@ -22,6 +25,7 @@ typedef struct {
   real *seg;       /* nseg * RHOD_SEG_STRIDE; n is the normal pointing into the fluid */
   int32_t *corner; /* ncorner * 2: segments meeting at a corner that needs a double mirror */
   real *circ;      /* ncirc * RHOD_CIRC_STRIDE */
+  int moving;      /* some segment has a non-zero velocity */
   int periodic[2];
   double lo[2], hi[2]; /* domain box */
   int32_t *count;      /* per-particle ghost counts (scan buffer), cap + 1 */
@@ -36,7 +40,12 @@ void rhod_boundary_free(rhod_boundary *b);
 /* Regenerates every ghost for the fluid at [0, p->n): wall mirrors of fluid particles
  * within `radius_ratio * dx_i` of a wall, then periodic images of fluid and wall
  * ghosts that fall within `margin` of the box. Grows the store if needed.
- * Copies x, y, m, dx into the ghosts and sets gsrc, gJ, gT, ge. */
+ * Copies x, y, m, dx into the ghosts and sets gsrc, gJ, gT, gU, ge. The wall part of a
+ * ghost's velocity, gU (u_g = T u_s + gU): 2 u_wall for a no-slip mirror (T = -I), 0 for
+ * a free-slip one (T = J: the wall's tangential motion does not act); at a double mirror
+ * in a corner (T = -I where either wall is no-slip, else J_b J_a) the mean of the
+ * no-slip walls' 2 u_wall (docs/choices.md "moving walls at corners"); a periodic image
+ * copies its source's. */
 int rhod_ghosts_build(rhod_boundary *b, rhod_particles *p, real radius_ratio, real margin);
 
 /* near[i] = 1 when the support of fluid particle i (radius radius_ratio * dx_i)

@@ -42,6 +42,8 @@ typedef struct {
    * displacement e used for the hydrostatic correction P' = P + rho g.e */
   int32_t *gsrc;
   real *gJ, *gT; /* 4 per particle */
+  real *gU;      /* 2 per particle: the moving wall's part of the ghost velocity,
+                    u_g = T u_src + gU (boundary.h); 0 where no wall moves */
   real *ge;      /* 2 per particle */
   /* scratch for reordering */
   void *scratch;

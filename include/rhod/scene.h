@@ -8,6 +8,12 @@
 #include "rhod/status.h"
 #include <stddef.h>
 
+/* scheme.name: which scheme runs the scene. rhodsph: paper 002 (RHOD-SPH, the default);
+ * multiphase: paper 000's multiphase scheme (its keys in rhod_scene.mp). */
+typedef enum { RHOD_SCHEME_RHODSPH = 0, RHOD_SCHEME_MULTIPHASE } rhod_scheme_kind;
+
+struct rhod_mp_scene; /* include/rhod/multiphase/scene.h */
+
 typedef enum { RHOD_SHAPE_RECT = 0, RHOD_SHAPE_POLYGON, RHOD_SHAPE_CIRCLE } rhod_shape_kind;
 
 typedef struct {
@@ -43,6 +49,7 @@ typedef struct {
   double surface;          /* hydrostatic: the free surface's level along -g [m], i.e. x.e
                               with e = -g/|g| (for g along -y, its y); default the block's
                               highest point along -g */
+  int phase;               /* fluid.N.phase: index into mp->phases; -1 for rhodsph */
   unsigned line, col;      /* where the block starts in the scene file (for messages);
                               0, 0 when an override (--set) supplied it */
 } rhod_fluid_block;
@@ -52,8 +59,12 @@ typedef enum { RHOD_SLIP_FREE = 0, RHOD_SLIP_NO } rhod_slip;
 /* A solid wall: the boundary of a shape, modelled by mirrored ghost particles. */
 typedef struct {
   rhod_shape shape;
-  rhod_slip slip;   /* free (default) or no-slip */
-  int fluid_inside; /* 1 (default): the shape is a container; 0: an obstacle */
+  rhod_slip slip;        /* free (default) or no-slip */
+  int fluid_inside;      /* 1 (default): the shape is a container; 0: an obstacle */
+  double velocity[2];    /* walls.N.velocity [m/s] of its moving edges, default [0, 0] */
+  unsigned moving_edges; /* bit k: edge k moves (rect: 0 bottom, 1 right, 2 top, 3 left;
+                            polygon: from points[k] to points[k+1], in the stored
+                            counter-clockwise order); 0 when the velocity is zero */
 } rhod_wall;
 
 typedef enum {
@@ -150,6 +161,8 @@ typedef struct {
 typedef enum { RHOD_QTY_PRESSURE = 0, RHOD_QTY_DYNAMIC_PRESSURE } rhod_quantity;
 
 typedef struct {
+  rhod_scheme_kind scheme;  /* scheme.name, default rhodsph */
+  struct rhod_mp_scene *mp; /* phases and the multiphase section; NULL for rhodsph */
   /* time: */
   double t_end;                    /* time.end [s] (required) */
   double output_every;             /* time.output_every [s] (required) */
@@ -285,5 +298,9 @@ void rhod_warn(rhod_warn_buf *w, const char *fmt, ...) __attribute__((format(pri
  * over dx^2 and, with refinement regions, the finer lattices of their overlap with the
  * blocks' bounding boxes (an upper estimate there). Before walls and domain cut it. */
 double rhod_scene_particle_estimate(const rhod_scene *s);
+
+/* Whether some wall edge moves (a non-zero walls.N.velocity): the ghosts then carry
+ * their wall's velocity (rhod_particles.gU). */
+int rhod_scene_walls_move(const rhod_scene *s);
 
 #endif

@@ -65,6 +65,7 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   s->gamma_th = (real)sc->shepard_threshold;
   s->theta_th = (real)sc->theta_threshold;
   s->visc_cons = sc->viscosity == RHOD_VISCOSITY_CONSISTENT && sc->mu > 0;
+  s->walls_move = rhod_scene_walls_move(sc);
   int st = RHOD_OK;
 #define F(var, k)                                                                                  \
   if (st == RHOD_OK)                                                                               \
@@ -111,9 +112,10 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
 void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   real *ux = p->ux, *uy = p->uy, *rho = p->rho, *P = s->P, *V = s->V;
-  const real *m = p->m, *gT = p->gT, *ge = p->ge;
+  const real *m = p->m, *gT = p->gT, *gU = p->gU, *ge = p->ge;
   const int32_t *gsrc = p->gsrc;
   const real c0 = s->c0, c2 = s->c0 * s->c0, rho0 = s->rho0, gx = s->gx, gy = s->gy;
+  const int walls_move = s->walls_move;
   (void)c0;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
@@ -124,8 +126,13 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
   for (long g = n; g < nt; g++) {
     const int k = gsrc[g];
     const real *T = gT + 4 * g;
-    ux[g] = T[0] * ux[k] + T[1] * uy[k];
-    uy[g] = T[2] * ux[k] + T[3] * uy[k];
+    /* u' = T u + gU (boundary.h): gU is a moving wall's part, added only when a wall
+     * moves, so that a scene at rest computes exactly what it did before */
+    real ugx = T[0] * ux[k] + T[1] * uy[k], ugy = T[2] * ux[k] + T[3] * uy[k];
+    if (walls_move)
+      ugx += gU[2 * g], ugy += gU[2 * g + 1];
+    ux[g] = ugx;
+    uy[g] = ugy;
     /* Hydrostatic correction of the mirrored pressure (scheme.md, Walls). Our choice:
      * the exact weakly compressible profile of the state law (Eq. 2), along which
      * c0^2 d rho = rho g . dx, so rho_g = rho_k exp(a) with a = g . (x_g - x_k) / c0^2,

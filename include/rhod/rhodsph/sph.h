@@ -64,12 +64,13 @@ typedef struct {
   real rho0, c0, mu, gx, gy;
   real cfl, cfl_visc;
   int riemann, recon, shifting, damper, fsdetect;
-  int tic;       /* scheme.tensile_control */
-  int shsw;      /* scheme.shifting_switch (rhod_shifting_switch) */
-  int adlim;     /* scheme.damper_step_limit (and the damper on) */
-  int visc_cons; /* scheme.viscosity: consistent (and mu > 0) */
-  int generic;   /* 1: the general copies of the gathers, never the specialised ones
-                    (tests/test_kernels.c compares them) */
+  int tic;        /* scheme.tensile_control */
+  int shsw;       /* scheme.shifting_switch (rhod_shifting_switch) */
+  int adlim;      /* scheme.damper_step_limit (and the damper on) */
+  int visc_cons;  /* scheme.viscosity: consistent (and mu > 0) */
+  int walls_move; /* some wall edge moves: ghost velocities add gU (rhod_sph_fill_state) */
+  int generic;    /* 1: the general copies of the gathers, never the specialised ones
+                     (tests/test_kernels.c compares them) */
   real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
   real ad_lambda; /* largest |eigenvalue| of Eq. 9 as last measured (rhod_sph_damper_probe);
                      0: none */
