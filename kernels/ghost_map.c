@@ -35,12 +35,13 @@ void rhod_ghosts_map_vector(const rhod_particles *p, real *v) {
 void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   const int32_t *gsrc = p->gsrc;
-  const real *gT = p->gT;
+  const real *gT = p->gT, *gU = p->gU;
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++) {
     const long k = gsrc[g];
     const real *T = gT + 4 * g, a = vx[k], b = vy[k];
-    vx[g] = T[0] * a + T[1] * b;
-    vy[g] = T[2] * a + T[3] * b;
+    /* u_g = T u_src + gU, gU the moving wall's part (0 where no wall moves) */
+    vx[g] = T[0] * a + T[1] * b + gU[2 * g];
+    vy[g] = T[2] * a + T[3] * b + gU[2 * g + 1];
   }
 }

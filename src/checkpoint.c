@@ -5,6 +5,7 @@
  *   f64 stiffness (version 3)
  *   i64 absorbed, f64 ke_merged ke_absorbed (version 4)
  *   f64 picture_range[2] (version 5; NaN NaN: no range fixed yet)
+ *   i32 nextra, (str name, f64 value)[nextra] (version 6: the scheme's scalars)
  *   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
  *   str scene_path   i32 nsets, str[nsets]   u32 nparams, (str key, str value)[nparams]
  *   u64 n next_id   i32 nfields, per field: str name, u64 elem, elem * n bytes
@@ -23,8 +24,8 @@
 #define CK_MAGIC "RHODCKP1"
 /* 2: the split and merge totals; 3: the stiffness limit's measure; 4: the absorbed
  * stragglers' total and the energy coalescing took out; 5: the pictures' colour range
- * fixed at the first picture; 1 to 4 are still read */
-#define CK_VERSION 5u
+ * fixed at the first picture; 6: the scheme's named scalars; 1 to 5 are still read */
+#define CK_VERSION 6u
 #define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
 #define CK_MAX_PROBES_BYTES ((uint64_t)1 << 40) /* probes.csv: 1 TiB */
 
@@ -93,6 +94,11 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
   put_f64(&w, ck->ke_absorbed);
   put_f64(&w, ck->picture_range[0]);
   put_f64(&w, ck->picture_range[1]);
+  put_i32(&w, ck->nextra);
+  for (int i = 0; i < ck->nextra; i++) {
+    put_str(&w, ck->extra_name[i]);
+    put_f64(&w, ck->extra[i]);
+  }
   put_u64(&w, ck->probes_bytes);
   put_i32(&w, ck->nsnap);
   put(&w, ck->snap_t, sizeof(double) * (size_t)ck->nsnap);
@@ -420,6 +426,24 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   if (version >= 5) {
     get(r, &ck->picture_range[0], 8, "picture_range");
     get(r, &ck->picture_range[1], 8, "picture_range");
+  }
+  if (version >= 6) {
+    get(r, &ck->nextra, 4, "nextra");
+    if (!r->bad && (ck->nextra < 0 || ck->nextra > RHOD_CK_MAX_EXTRAS)) {
+      r->bad = 1;
+      r->what = "nextra";
+    }
+    for (int i = 0; i < ck->nextra && !r->bad; i++) {
+      char *name = get_str(r, "extra name");
+      if (!r->bad && (!name || strlen(name) >= sizeof ck->extra_name[i])) {
+        r->bad = 1;
+        r->what = "extra name";
+      }
+      if (!r->bad)
+        strcpy(ck->extra_name[i], name);
+      free(name);
+      get(r, &ck->extra[i], 8, "extra value");
+    }
   }
   get(r, &ck->probes_bytes, 8, "probes_bytes");
   ck->nsnap = (int32_t)get_count(r, "nsnap");

@@ -99,8 +99,8 @@ void rhod_ghosts_map_scalar(const rhod_particles *p, real *f);
 void rhod_ghosts_map_u8(const rhod_particles *p, uint8_t *f);
 /* v_g = J v_src for a vector stored 2 per particle (a normal, a gradient of a scalar) */
 void rhod_ghosts_map_vector(const rhod_particles *p, real *v);
-/* (vx, vy)_g = T (vx, vy)_src: a velocity (T is J for free slip and periodic images,
- * -I for no slip) */
+/* (vx, vy)_g = T (vx, vy)_src + gU: a velocity (T is J for free slip and periodic images,
+ * -I for no slip; gU a moving wall's part, 0 where no wall moves) */
 void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy);
 
 #endif

@@ -15,6 +15,8 @@
 #include "rhod/scene.h"
 #include <stdint.h>
 
+#define RHOD_CK_MAX_EXTRAS 16
+
 typedef struct {
   /* run state */
   double t, next_out, next_probe, next_checkpoint, checkpoint_every;
@@ -25,7 +27,10 @@ typedef struct {
   double ke_merged, ke_absorbed; /* the energy coalescing took out so far (idem) */
   double picture_range[2];       /* the pictures' colour range, fixed at the first picture that
                                     had one (version 5); NaN, NaN: none fixed yet */
-  uint64_t probes_bytes;         /* length of probes.csv when the checkpoint was taken */
+  int32_t nextra; /* the scheme's scalars (its ops->save and ops->load), by name (version 6) */
+  char extra_name[RHOD_CK_MAX_EXTRAS][32];
+  double extra[RHOD_CK_MAX_EXTRAS];
+  uint64_t probes_bytes; /* length of probes.csv when the checkpoint was taken */
   int32_t nsnap;
   double *snap_t;
   uint64_t *snap_n;

@@ -298,13 +298,28 @@ void rhod_mp_rhs(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt) {
 /* Paper 001 Eqs. 14-17, per particle, with h_s = hs_fac R_i:
  * 14: C_tau h_s^2 rho_i / mu_i, 15: C_a sqrt(h_s / |a_i|), 16: C_c h_s / c_i,
  * 17: C_sigma sqrt(h_s^3 rho_i / (2 pi sigma)), sigma the largest of i's phase's pairs. */
+real rhod_mp_force_dt(const rhod_mp *m, const rhod_particles *p) {
+  const long n = (long)p->n;
+  const real *dx = p->dx, *acc = m->acc;
+  const real hsR = m->hs_fac * m->prm.ratio, ca = m->prm.cfl_force;
+  real d15 = BIG;
+  RHOD_KERNEL_LOOP_REDUCE(min, d15)
+  for (long i = 0; i < n; i++) {
+    const real hs = hsR * dx[i];
+    const real am = sqrt(acc[2 * i] * acc[2 * i] + acc[2 * i + 1] * acc[2 * i + 1]);
+    const real a = am > 0 ? ca * sqrt(hs / am) : BIG; /* Eq. 15 */
+    d15 = a < d15 ? a : d15;
+  }
+  return d15;
+}
+
 real rhod_mp_dt(rhod_mp *m, const rhod_particles *p) {
   const long n = (long)p->n;
-  const real *dx = p->dx, *rho = p->rho, *acc = m->acc, *T = m->tab;
+  const real *dx = p->dx, *rho = p->rho, *T = m->tab;
   const uint8_t *ph = p->phase;
   const real hsR = m->hs_fac * m->prm.ratio;
-  const real cv = m->prm.cfl_visc, ca = m->prm.cfl_force, cc = m->prm.cfl, cs = m->prm.cfl_surface;
-  real d14 = BIG, d17 = BIG, d15 = BIG, d16 = BIG;
+  const real cv = m->prm.cfl_visc, cc = m->prm.cfl, cs = m->prm.cfl_surface;
+  real d14 = BIG, d17 = BIG, d16 = BIG;
   RHOD_KERNEL_LOOP_REDUCE2(min, d14, d17)
   for (long i = 0; i < n; i++) {
     const int k = ph[i];
@@ -315,15 +330,14 @@ real rhod_mp_dt(rhod_mp *m, const rhod_particles *p) {
     d14 = a < d14 ? a : d14;
     d17 = b < d17 ? b : d17;
   }
-  RHOD_KERNEL_LOOP_REDUCE2(min, d15, d16)
+  RHOD_KERNEL_LOOP_REDUCE(min, d16)
   for (long i = 0; i < n; i++) {
     const real hs = hsR * dx[i];
-    const real am = sqrt(acc[2 * i] * acc[2 * i] + acc[2 * i + 1] * acc[2 * i + 1]);
-    const real a = am > 0 ? ca * sqrt(hs / am) : BIG;         /* Eq. 15 */
     const real b = cc * hs / T[RHOD_MP_TAB_C * MAXP + ph[i]]; /* Eq. 16 */
-    d15 = a < d15 ? a : d15;
     d16 = b < d16 ? b : d16;
   }
+  /* Eq. 15: as the caller kept it after the step's last right-hand side, or from acc */
+  const real d15 = m->force_dt > 0 ? m->force_dt : rhod_mp_force_dt(m, p);
   real dt = d14;
   m->dt_by = RHOD_MP_DT_VISC;
   if (d15 < dt)

@@ -60,14 +60,17 @@ enum {
 
 typedef struct {
   rhod_mp_params prm;
-  real hfac;   /* h / R: 1/2 Wendland, 1/3 quintic */
-  real hs_fac; /* h_s / R, h_s = 2 x the kernel's per-axis standard deviation (computed
-                  at init by quadrature: 0.5270 C2, 0.4606 C4, 0.4634 quintic) */
-  int surface; /* 1 when some sigma > 0: the colour-gradient pass runs */
-  real *tab;   /* phase table (RHOD_MP_TAB_*), RHOD_MP_TAB_SIZE reals, on the device */
-  int dt_by;   /* which limit set the last rhod_mp_dt: RHOD_MP_DT_* */
-  real us_max; /* max |u_s| dt / dx of the fluid after the last rhs (multiphase.md: logged,
-                  no cap) */
+  real hfac;     /* h / R: 1/2 Wendland, 1/3 quintic */
+  real hs_fac;   /* h_s / R, h_s = 2 x the kernel's per-axis standard deviation (computed
+                    at init by quadrature: 0.5270 C2, 0.4606 C4, 0.4634 quintic) */
+  int surface;   /* 1 when some sigma > 0: the colour-gradient pass runs */
+  real *tab;     /* phase table (RHOD_MP_TAB_*), RHOD_MP_TAB_SIZE reals, on the device */
+  int dt_by;     /* which limit set the last rhod_mp_dt: RHOD_MP_DT_* */
+  real force_dt; /* > 0: Eq. 15's limit rhod_mp_dt takes instead of computing it from acc:
+                    the caller sets it (rhod_mp_force_dt) after a step's last right-hand side,
+                    before the particles are sorted again, and a resume carries it */
+  real us_max;   /* max |u_s| dt / dx of the fluid after the last rhs (multiphase.md: logged,
+                    no cap) */
   /* per-particle fields (scratch, rebuilt each stage) */
   real *P, *V;
   real *gC;               /* colour gradient grad C (001 Eq. 8, Adami's colour), 2 */
@@ -101,5 +104,7 @@ void rhod_mp_pass_main(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real 
 /* The time step of paper 001 Eqs. 14-17 (the four limits; |a_i| from the last rhs' acc);
  * dt_by says which one set it. */
 real rhod_mp_dt(rhod_mp *m, const rhod_particles *p);
+/* Eq. 15 alone, from the last right-hand side's accelerations. */
+real rhod_mp_force_dt(const rhod_mp *m, const rhod_particles *p);
 
 #endif
