@@ -228,6 +228,7 @@ static const struct {
     {"time.cfl=0.3", "time.cfl", "belongs to the rhodsph scheme"},
     {"scheme.shifting=false", "scheme.shifting", "belongs to the rhodsph scheme"},
     {"refinement.levels=2", "refinement.levels", "belongs to the rhodsph scheme"},
+    {"refinement={}", "refinement", "belongs to the rhodsph scheme"},
     {"scheme.name=sph", "scheme.name", "invalid value 'sph'"},
     {"walls.0={circle: {center: [0, 0], radius: 2}, velocity: [1, 0]}", "walls.0.velocity",
      "a circle wall cannot move"},
