@@ -3,9 +3,9 @@
  * Sec. 2.3). All are per-particle loops that write only particle i's own entries (the children of i
  * go to slots reserved for i by a scan; a merged group is written by its leader), so they run on
  * the device like every other kernel. */
+#include "rhod/device.h"
 #include "rhod/kernel.h"
 #include "rhod/rhodsph/apr.h"
-#include "rhod/device.h"
 #include <math.h>
 #include <string.h>
 
