@@ -77,6 +77,7 @@ static const glyph font[] = {
     {'g', {0x00, 0x0F, 0x11, 0x11, 0x0F, 0x01, 0x0E}},
     {'l', {0x0C, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E}},
     {'a', {0x00, 0x00, 0x0E, 0x01, 0x0F, 0x11, 0x0F}},
+    {'d', {0x01, 0x01, 0x0D, 0x13, 0x11, 0x11, 0x0F}},
     {'e', {0x00, 0x00, 0x0E, 0x11, 0x1F, 0x10, 0x0E}},
     {'f', {0x06, 0x09, 0x08, 0x1C, 0x08, 0x08, 0x08}},
     {'h', {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x11}},
@@ -158,6 +159,8 @@ static const char *field_label(rhod_field f) {
     return "size [m]";
   case RHOD_FIELD_FREE_SURFACE:
     return "free surface [1]";
+  case RHOD_FIELD_PHASE:
+    return "phase [index]";
   }
   return "";
 }
@@ -174,6 +177,8 @@ static double field_value(const rhod_snapshot_view *v, rhod_field f, size_t i) {
     return (double)v->size[i];
   case RHOD_FIELD_FREE_SURFACE:
     return v->fs ? (double)v->fs[i] : 0.0;
+  case RHOD_FIELD_PHASE:
+    return v->phase ? (double)v->phase[i] : 0.0;
   }
   return 0.0;
 }
@@ -190,6 +195,7 @@ static int field_present(const rhod_snapshot_view *v, rhod_field f) {
   case RHOD_FIELD_SIZE:
     return 1;
   case RHOD_FIELD_FREE_SURFACE:
+  case RHOD_FIELD_PHASE: /* NULL: one phase, every particle 0 */
     return 1;
   }
   return 0;
@@ -623,7 +629,7 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
                path, width, lo[0], hi[0], lo[1], hi[1], MAX_SIDE);
     return RHOD_ERR_SCENE;
   }
-  if ((int)field < RHOD_FIELD_PRESSURE || (int)field > RHOD_FIELD_FREE_SURFACE) {
+  if ((int)field < RHOD_FIELD_PRESSURE || (int)field > RHOD_FIELD_PHASE) {
     if (err && errlen)
       snprintf(err, errlen, "%s: cannot draw: unknown field %d", path, field);
     return RHOD_ERR_SCENE;

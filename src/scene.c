@@ -256,7 +256,7 @@ static const cyaml_strval_t slip_names[] = {
 static const cyaml_strval_t field_names[] = {
     {"pressure", RHOD_FIELD_PRESSURE},         {"velocity", RHOD_FIELD_VELOCITY},
     {"density", RHOD_FIELD_DENSITY},           {"size", RHOD_FIELD_SIZE},
-    {"free_surface", RHOD_FIELD_FREE_SURFACE},
+    {"free_surface", RHOD_FIELD_FREE_SURFACE}, {"phase", RHOD_FIELD_PHASE},
 };
 static const cyaml_strval_t quantity_names[] = {
     {"pressure", RHOD_QTY_PRESSURE},

@@ -483,6 +483,25 @@ static void test_picture(void) {
   CU_ASSERT(pixel_is(&im, g.frame_x + 50, g.frame_y + 50, 253, 231, 37));
   CU_ASSERT(pixel_is(&im, g.frame_x + 150, g.frame_y + 50, 68, 1, 84));
   free(im.px);
+  /* coloured by phase: particle 0 of phase 1 the top colour, particle 1 of phase 0 the
+   * bottom one over [0, 1]; without phases every particle is phase 0 */
+  const uint8_t ph[4] = {1, 0, 0, 0};
+  v.phase = ph;
+  double r01[2] = {0, 1};
+  CU_ASSERT_EQUAL(
+      rhod_write_picture(path, &v, RHOD_FIELD_PHASE, 0, 200, lo, hi, r01, NULL, 0, err, sizeof err),
+      RHOD_OK);
+  CU_ASSERT_FATAL(read_png(path, &im));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 50, g.frame_y + 50, 253, 231, 37));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 150, g.frame_y + 50, 68, 1, 84));
+  free(im.px);
+  v.phase = NULL;
+  CU_ASSERT_EQUAL(
+      rhod_write_picture(path, &v, RHOD_FIELD_PHASE, 0, 200, lo, hi, r01, NULL, 0, err, sizeof err),
+      RHOD_OK);
+  CU_ASSERT_FATAL(read_png(path, &im));
+  CU_ASSERT(pixel_is(&im, g.frame_x + 50, g.frame_y + 50, 68, 1, 84));
+  free(im.px);
   v.fs = NULL;
   CU_ASSERT_EQUAL(rhod_write_picture(path, &v, RHOD_FIELD_FREE_SURFACE, 0, 100, lo, hi, NULL, NULL,
                                      0, err, sizeof err),

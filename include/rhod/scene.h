@@ -98,7 +98,8 @@ typedef enum {
   RHOD_FIELD_VELOCITY, /* magnitude */
   RHOD_FIELD_DENSITY,
   RHOD_FIELD_SIZE,
-  RHOD_FIELD_FREE_SURFACE
+  RHOD_FIELD_FREE_SURFACE,
+  RHOD_FIELD_PHASE /* the phase index (multiphase scheme) */
 } rhod_field;
 
 /* Most particle sizes a scene may use: dx, dx/e, ..., dx/e^(RHOD_MAX_LEVELS-1). */
