@@ -64,6 +64,39 @@ check "APR: the run split particles" -- grep -q '"splits": [1-9]' "$T/e/summary.
 check "APR: split, merge and reflection totals carried over the restart" -- \
   test "$(totals "$T/e")" = "$(totals "$T/f")"
 
+# 5. the multiphase scheme (paper 000): a liquid square relaxing under surface tension in a
+#    periodic gas, two phases, the colour pass, the midpoint integrator; the time step's
+#    force limit (paper 001 Eq. 15) comes from the last step's accelerations, which the
+#    checkpoint carries as a named scalar
+cat >"$T/mp.yaml" <<'YAML'
+name: mp_restart
+scheme: {name: multiphase}
+time: {end: 0.05, output_every: 0.005}
+particles: {dx: 0.025, jitter: 0.1}
+phases:
+  - {name: liquid, rho0: 1, c: 10, mu: 0.05}
+  - {name: gas, rho0: 0.5, c: 10, mu: 0.05, gamma: 1}
+multiphase: {sigma: 1, cfl_force: 0.01} # the force limit (Eq. 15) sets dt
+domain: {min: [0, 0], max: [1, 1], periodic: [true, true]}
+fluid:
+  - rect: {min: [0.3, 0.3], max: [0.7, 0.7]}
+    phase: liquid
+  - rect: {min: [0, 0], max: [1, 1]}
+    phase: gas
+probes:
+  every: 0.001
+  list: [kinetic_energy: {name: ke}, mass: {}]
+output:
+  picture: {field: phase, width: 200}
+YAML
+expect 0 "multiphase: uninterrupted run" -- "$RHOD" run "$T/mp.yaml" -o "$T/m" --checkpoint-every 0.02
+cp -r "$T/m" "$T/n"
+rm -f "$T/n"/snapshot_0009.* "$T/n"/snapshot_0010.*
+expect 0 "multiphase: resume after a crash" -- "$RHOD" resume "$T/n"
+check "multiphase: resumed run identical to the uninterrupted one" -- same_outputs "$T/m" "$T/n"
+check "multiphase: the snapshots hold the phase" -- \
+  grep -q "snapshot_0010.h5:/PartType0/Phase" "$T/n/snapshots.xdmf"
+
 # 4. bad checkpoints: exit 10, one line naming the file and the reason
 cp -r "$T/a" "$T/d"
 printf 'X' | dd of="$T/d/checkpoint.rhod" bs=1 seek=5000 conv=notrunc 2>/dev/null
