@@ -256,3 +256,18 @@ long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag) {
   }
   return c->nsub = sort_counted(u, key, flag, n);
 }
+
+void rhod_cells_pack(const rhod_cells *c, long nt, real *row, const real *src, int stride,
+                     int comp) {
+  const int32_t *CI = c->idx;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt; k++)
+    row[k] = src[(long)stride * CI[k] + comp];
+}
+
+void rhod_cells_pack_u8(const rhod_cells *c, long nt, real *row, const uint8_t *src) {
+  const int32_t *CI = c->idx;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nt; k++)
+    row[k] = (real)src[CI[k]];
+}

@@ -242,6 +242,14 @@ static inline int rhod_cells_near_any_(const int32_t *CS, real ox, real oy, real
   rhod_cells_near_any_((CS), (G).ox, (G).oy, (G).inv, (G).cx0, (G).cy0, (G).nx, (G).ny,            \
                        rhod_cell_reach((G), (R)), (x), (y))
 
+/* Neighbour-side fields copied into the order of the last build (cell order), so that a
+ * gather's inner loop over a row of cells reads them contiguously and vectorises
+ * (RHOD_FOR_ROWS, RHOD_FOR_LANES): row[k] = src[stride * idx[k] + comp] for k < nt (the
+ * particles of the build), or from a uint8 field as a real. On the device. */
+void rhod_cells_pack(const rhod_cells *c, long nt, real *row, const real *src, int stride,
+                     int comp);
+void rhod_cells_pack_u8(const rhod_cells *c, long nt, real *row, const uint8_t *src);
+
 /* Exclusive prefix sum of n ints in place on the device; returns the total. */
 long rhod_scan_exclusive(int32_t *a, size_t n);
 

@@ -152,34 +152,30 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
 
 static void pack_a(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   const long nt = (long)(p->n + p->ng), st = (long)p->cap;
-  const int32_t *CI = c->idx;
-  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *dx = p->dx, *P = s->P, *V = s->V;
   real *pk = s->pk;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nt; k++) {
-    const int j = CI[k];
-    pk[RHOD_PK_X * st + k] = x[j], pk[RHOD_PK_Y * st + k] = y[j], pk[RHOD_PK_V * st + k] = V[j];
-    pk[RHOD_PK_P * st + k] = P[j], pk[RHOD_PK_UX * st + k] = ux[j], pk[RHOD_PK_UY * st + k] = uy[j];
-    pk[RHOD_PK_DX * st + k] = dx[j];
-  }
+  rhod_cells_pack(c, nt, pk + RHOD_PK_X * st, p->x, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_Y * st, p->y, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_V * st, s->V, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_P * st, s->P, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_UX * st, p->ux, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_UY * st, p->uy, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_DX * st, p->dx, 1, 0);
 }
 
 static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   const long nt = (long)(p->n + p->ng), st = (long)p->cap;
-  const int32_t *CI = c->idx;
-  const real *D = s->D, *gP = s->gP, *gu = s->gu, *du = s->du, *rho = p->rho, *dup = s->dup;
   real *pk = s->pk;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nt; k++) {
-    const int j = CI[k];
-    pk[RHOD_PK_D * st + k] = D[j];
-    pk[RHOD_PK_GPX * st + k] = gP[2 * j], pk[RHOD_PK_GPY * st + k] = gP[2 * j + 1];
-    pk[RHOD_PK_GU0 * st + k] = gu[4 * j], pk[RHOD_PK_GU1 * st + k] = gu[4 * j + 1];
-    pk[RHOD_PK_GU2 * st + k] = gu[4 * j + 2], pk[RHOD_PK_GU3 * st + k] = gu[4 * j + 3];
-    pk[RHOD_PK_DUX * st + k] = du[2 * j], pk[RHOD_PK_DUY * st + k] = du[2 * j + 1];
-    pk[RHOD_PK_RHO * st + k] = rho[j];
-    if (dup) /* a balanced shifting switch only */
-      pk[RHOD_PK_DPX * st + k] = dup[2 * j], pk[RHOD_PK_DPY * st + k] = dup[2 * j + 1];
+  rhod_cells_pack(c, nt, pk + RHOD_PK_D * st, s->D, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_GPX * st, s->gP, 2, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_GPY * st, s->gP, 2, 1);
+  for (int a = 0; a < 4; a++)
+    rhod_cells_pack(c, nt, pk + (RHOD_PK_GU0 + a) * st, s->gu, 4, a);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_DUX * st, s->du, 2, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_DUY * st, s->du, 2, 1);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_RHO * st, p->rho, 1, 0);
+  if (s->dup) { /* a balanced shifting switch only */
+    rhod_cells_pack(c, nt, pk + RHOD_PK_DPX * st, s->dup, 2, 0);
+    rhod_cells_pack(c, nt, pk + RHOD_PK_DPY * st, s->dup, 2, 1);
   }
 }
 
@@ -515,13 +511,10 @@ void rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   for (long g = n; g < nt; g++)
     jmp[g] = 1;
   const long nf = rhod_cells_build_subset(c, jmp);
-  const int32_t *CI = c->sub->idx;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nf; k++) {
-    const int j = CI[k];
-    pk[RHOD_PK_JX * st + k] = x[j], pk[RHOD_PK_JY * st + k] = y[j];
-    pk[RHOD_PK_JV * st + k] = V[j], pk[RHOD_PK_JDX * st + k] = dx[j];
-  }
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JX * st, x, 1, 0);
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JY * st, y, 1, 0);
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JV * st, V, 1, 0);
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JDX * st, dx, 1, 0);
   const rhod_grid G = c->g, GS = c->sub->g;
   const int32_t *CS = c->start, *SS = c->sub->start;
   const real ratio = s->ratio;
@@ -695,14 +688,12 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
    * positions and normals packed in that order */
   const long nf = rhod_cells_build_subset(c, fs), st = (long)p->cap;
   const rhod_grid G = c->sub->g;
-  const int32_t *CS = c->sub->start, *CI = c->sub->idx;
+  const int32_t *CS = c->sub->start;
   real *pk = s->pk;
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nf; k++) {
-    const int j = CI[k];
-    pk[RHOD_PK_FX * st + k] = x[j], pk[RHOD_PK_FY * st + k] = y[j];
-    pk[RHOD_PK_FNX * st + k] = nrm[2 * j], pk[RHOD_PK_FNY * st + k] = nrm[2 * j + 1];
-  }
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FX * st, x, 1, 0);
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FY * st, y, 1, 0);
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FNX * st, nrm, 2, 0);
+  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FNY * st, nrm, 2, 1);
   const int kern = s->kernel, generic = s->generic;
   const real ratio = s->ratio;
   (void)generic;
@@ -1189,7 +1180,7 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
   const real *x = p->x, *y = p->y, *dx = p->dx, *rho = p->rho, *V = s->V;
   const real *gJ = p->gJ, *gT = p->gT;
   const uint64_t *id = p->id;
-  const int32_t *gsrc = p->gsrc, *CI = c->idx, *CS = c->start;
+  const int32_t *gsrc = p->gsrc, *CS = c->start;
   const rhod_grid G = c->g;
   const int kern = s->kernel;
   const real ratio = s->ratio, kad = s->alpha_ad * s->rho0 * s->c0 * (real)0.5; /* Eq. 9 */
@@ -1216,12 +1207,11 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     v[2 * g] = T[0] * v[2 * k] + T[1] * v[2 * k + 1];
     v[2 * g + 1] = T[2] * v[2 * k] + T[3] * v[2 * k + 1];
   }
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nt; k++) {
-    const int j = CI[k];
-    pk[RHOD_PK_X * st + k] = x[j], pk[RHOD_PK_Y * st + k] = y[j], pk[RHOD_PK_V * st + k] = V[j];
-    pk[RHOD_PK_UX * st + k] = v[2 * j], pk[RHOD_PK_UY * st + k] = v[2 * j + 1];
-  }
+  rhod_cells_pack(c, nt, pk + RHOD_PK_X * st, x, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_Y * st, y, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_V * st, V, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_UX * st, v, 2, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_PK_UY * st, v, 2, 1);
   /* D of the iterate (Eq. 5) and its renormalised gradient (Eqs. 8 and 14, as pass A) */
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
@@ -1264,9 +1254,7 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     const int k = gsrc[g];
     aD[g] = ghost_div(gJ + 4 * g, gT + 4 * g, aG + 4 * k, aD[k]);
   }
-  RHOD_KERNEL_LOOP
-  for (long k = 0; k < nt; k++)
-    pk[RHOD_PK_D * st + k] = aD[CI[k]];
+  rhod_cells_pack(c, nt, pk + RHOD_PK_D * st, aD, 1, 0);
   /* F^AD / rho of the iterate (Eq. 9, h_i = R_i / 2 as in pass C), which becomes the next
    * iterate; |A v| / |v| estimates the largest |lambda|. The norms are summed in loops
    * of their own, so that the gather needs no reduction (RHOD_GATHER_LOOP) */
