@@ -11,6 +11,14 @@
 #include <string.h>
 
 #define MAXP RHOD_MP_MAX_PHASES
+
+/* A gather's per-particle body: inlined into each specialised copy on the host (one copy
+ * on the device, where it stays a call to keep the device code small). */
+#ifdef RHOD_OFFLOAD
+#define PARTICLE_BODY static inline
+#else
+#define PARTICLE_BODY static inline __attribute__((always_inline))
+#endif
 #define BIG ((real)1e30)
 
 /* h / R of a kernel (paper 000 Appendix A): Wendland h = R/2 (h/dx = 2 at R = 4 dx),
@@ -68,6 +76,9 @@ int rhod_mp_init(rhod_mp *m, const rhod_mp_params *prm, rhod_particles *p) {
   st = rhod_particles_add_field(p, "mp_" #var, (void **)&m->var, (k) * sizeof(*m->var), 0)
   F(P, 1);
   F(V, 1);
+  F(nu, 1);
+  F(col, 1);
+  F(pk, m->surface ? RHOD_MP_PK_ROWS : RHOD_MP_PK_ROWS_PLAIN);
   F(us, 2);
   F(drho, 1);
   F(acc, 2);
@@ -101,13 +112,15 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
   const long n = (long)p->n;
   const real *rho = p->rho, *mass = p->m, *T = m->tab;
   const uint8_t *ph = p->phase;
-  real *P = m->P, *V = m->V;
+  real *P = m->P, *V = m->V, *nu = m->nu, *col = m->col;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     const int k = ph[i];
     P[i] = rhod_mp_eos(T[RHOD_MP_TAB_RHO0 * MAXP + k], T[RHOD_MP_TAB_C * MAXP + k],
                        T[RHOD_MP_TAB_GAMMA * MAXP + k], rho[i]); /* paper 000 Eq. 3 */
     V[i] = mass[i] / rho[i];
+    nu[i] = T[RHOD_MP_TAB_MU * MAXP + k] / rho[i];
+    col[i] = T[RHOD_MP_TAB_COLOUR * MAXP + k];
   }
   /* ghosts: plain copies of the source's state (no hydrostatic correction), the velocity
    * through T (free slip, no slip, periodic images) */
@@ -115,7 +128,26 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
   rhod_ghosts_map_scalar(p, p->rho);
   rhod_ghosts_map_scalar(p, m->P);
   rhod_ghosts_map_scalar(p, m->V);
+  rhod_ghosts_map_scalar(p, m->nu);
+  rhod_ghosts_map_scalar(p, m->col);
   rhod_ghosts_map_u8(p, p->phase);
+}
+
+/* The rows every gather reads, in the order of the cells' last build (fluid and ghosts). */
+static void pack_state(rhod_mp *m, const rhod_particles *p, const rhod_cells *c) {
+  const long nt = (long)(p->n + p->ng), st = (long)p->cap;
+  real *pk = m->pk;
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_X * st, p->x, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_Y * st, p->y, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_V * st, m->V, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_P * st, m->P, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_UX * st, p->ux, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_UY * st, p->uy, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_RHO * st, p->rho, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_M * st, p->m, 1, 0);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_NU * st, m->nu, 1, 0);
+  rhod_cells_pack_u8(c, nt, pk + RHOD_MP_PK_PH * st, p->phase);
+  rhod_cells_pack(c, nt, pk + RHOD_MP_PK_COL * st, m->col, 1, 0);
 }
 
 /* Pass 1 (only with surface tension): the colour gradient of Adami et al. with the
@@ -124,53 +156,81 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
  * and the surface tension of i's interface: the W-weighted mean of sigma(phase_i,
  * phase_j) over the neighbours j of another colour (our choice for more than two phases;
  * exactly the pair's sigma for two). */
+#define COLOUR_PARAMS                                                                              \
+  rhod_grid G, const int32_t *CS, long st, const real *x, const real *y, const real *dx,           \
+      const real *rho, const real *V, const real *T, const real *pk, const real *col,              \
+      const uint8_t *ph, real *gC, real *nrm, real *sig, real ratio, real hfac
+#define COLOUR_ARGS G, CS, st, x, y, dx, rho, V, T, pk, col, ph, gC, nrm, sig, ratio, hfac
+
+/* The colour pass's gather of particle i (kern a constant in the host's copies). */
+PARTICLE_BODY void colour_particle(long i, COLOUR_PARAMS, const int kern) {
+  const real *kx = pk + RHOD_MP_PK_X * st, *ky = pk + RHOD_MP_PK_Y * st,
+             *kV = pk + RHOD_MP_PK_V * st, *krho = pk + RHOD_MP_PK_RHO * st,
+             *kph = pk + RHOD_MP_PK_PH * st, *kcol = pk + RHOD_MP_PK_COL * st;
+  const real xi = x[i], yi = y[i], Ri = ratio * dx[i], iR = 1 / Ri, R2 = Ri * Ri;
+  const real iR2 = iR * iR, iR3 = iR2 * iR;
+  const real rhoi = rho[i], Vi = V[i], ci = col[i];
+  const int pi = ph[i];
+  const real *sigrow = T + RHOD_MP_TAB_SIGMA * MAXP + pi * MAXP;
+  real RHOD_LANES(sgx), RHOD_LANES(sgy), RHOD_LANES(sww), RHOD_LANES(ssw), RHOD_LANES(srw);
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+    RHOD_FOR_LANES(k0, kv, k) {
+      const real rx = xi - kx[k], ry = yi - ky[k], r2 = rx * rx + ry * ry;
+      if (!(r2 < R2 && r2 > 0))
+        continue;
+      const real r = sqrt(r2), q = r * iR;
+      const real dWr = rhod_dWq(kern, q) * iR3 / r; /* grad W_ij = dWr r_ij */
+      const real cj = kcol[k], rhoj = krho[k];
+      /* paper 001 Eq. 8: (1/V_i) sum_j f_ij grad W_ij, f_ij = (V_i^2 + V_j^2) c~_ij */
+      const real f = rhod_mp_colour_f(Vi, kV[k], rhoi, rhoj, ci, cj);
+      RHOD_LANE(sgx) += f * dWr * rx;
+      RHOD_LANE(sgy) += f * dWr * ry;
+      /* the neighbours of another colour: the interface's sigma and density weight */
+      const real w = cj != ci ? rhod_Wq(kern, q) * iR2 : 0;
+      RHOD_LANE(sww) += w;
+      RHOD_LANE(ssw) += sigrow[(int)kph[k]] * w;
+      RHOD_LANE(srw) += rhoi / (rhoi + rhoj) * w;
+    }
+    RHOD_END_LANES
+  }
+  RHOD_END_ROWS
+  const real gx = RHOD_LANES_SUM(sgx) / Vi, gy = RHOD_LANES_SUM(sgy) / Vi;
+  const real ww = RHOD_LANES_SUM(sww), sw = RHOD_LANES_SUM(ssw), rw = RHOD_LANES_SUM(srw);
+  gC[2 * i] = gx, gC[2 * i + 1] = gy;
+  sig[i] = ww > 0 ? sw / ww : 0;
+  const real g = sqrt(gx * gx + gy * gy), h = hfac * Ri;
+  /* paper 001 Eq. 9, where reliable: Morris' |grad C| > 0.01/h, scaled by the density
+   * weight (2 rw/ww = 1 for equal densities) that Adami's colour gives i's side */
+  const int ok = ww > 0 && g > RHOD_MP_NORMAL_EPS * 2 * (rw / ww) / h;
+  nrm[2 * i] = ok ? gx / g : 0;
+  nrm[2 * i + 1] = ok ? gy / g : 0;
+}
+
 void rhod_mp_pass_colour(rhod_mp *m, rhod_particles *p, const rhod_cells *c) {
-  const long n = (long)p->n;
+  const long n = (long)p->n, st = (long)p->cap;
   const rhod_grid G = c->g;
-  const int32_t *CS = c->start, *CI = c->idx;
+  const int32_t *CS = c->start;
   const real *x = p->x, *y = p->y, *dx = p->dx, *rho = p->rho, *V = m->V, *T = m->tab;
+  const real *pk = m->pk, *col = m->col;
   const uint8_t *ph = p->phase;
   real *gC = m->gC, *nrm = m->nrm, *sig = m->sig;
   const int kern = m->prm.kernel;
   const real ratio = m->prm.ratio, hfac = m->hfac;
+#ifdef RHOD_OFFLOAD
+  RHOD_GATHER_LOOP
+  for (long i = 0; i < n; i++)
+    colour_particle(i, COLOUR_ARGS, kern);
+#else
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
-    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], iR = 1 / Ri, R2 = Ri * Ri;
-    const real rhoi = rho[i], Vi = V[i];
-    const int pi = ph[i];
-    const real ci = T[RHOD_MP_TAB_COLOUR * MAXP + pi];
-    real gx = 0, gy = 0, ww = 0, sw = 0, rw = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = xi - x[j], ry = yi - y[j], r2 = rx * rx + ry * ry;
-      if (!(r2 < R2 && r2 > 0))
-        continue;
-      const real r = sqrt(r2), q = r * iR;
-      const real dWr = rhod_dWq(kern, q) * iR * iR * iR / r; /* grad W_ij = dWr r_ij */
-      const int pj = ph[j];
-      const real cj = T[RHOD_MP_TAB_COLOUR * MAXP + pj];
-      /* paper 001 Eq. 8: (1/V_i) sum_j f_ij grad W_ij, f_ij = (V_i^2 + V_j^2) c~_ij */
-      const real f = rhod_mp_colour_f(Vi, V[j], rhoi, rho[j], ci, cj);
-      gx += f * dWr * rx;
-      gy += f * dWr * ry;
-      if (cj != ci) {
-        const real w = rhod_Wq(kern, q) * iR * iR;
-        ww += w;
-        sw += T[RHOD_MP_TAB_SIGMA * MAXP + pi * MAXP + pj] * w;
-        rw += rhoi / (rhoi + rho[j]) * w;
-      }
-    }
-    RHOD_END_NEIGHBOURS
-    gx /= Vi;
-    gy /= Vi;
-    gC[2 * i] = gx, gC[2 * i + 1] = gy;
-    sig[i] = ww > 0 ? sw / ww : 0;
-    const real g = sqrt(gx * gx + gy * gy), h = hfac * Ri;
-    /* paper 001 Eq. 9, where reliable: Morris' |grad C| > 0.01/h, scaled by the density
-     * weight (2 rw/ww = 1 for equal densities) that Adami's colour gives i's side */
-    const int ok = ww > 0 && g > RHOD_MP_NORMAL_EPS * 2 * (rw / ww) / h;
-    nrm[2 * i] = ok ? gx / g : 0;
-    nrm[2 * i + 1] = ok ? gy / g : 0;
+    if (kern == RHOD_KERNEL_WENDLAND_C4)
+      colour_particle(i, COLOUR_ARGS, RHOD_KERNEL_WENDLAND_C4);
+    else if (kern == RHOD_KERNEL_QUINTIC)
+      colour_particle(i, COLOUR_ARGS, RHOD_KERNEL_QUINTIC);
+    else
+      colour_particle(i, COLOUR_ARGS, kern);
   }
+#endif
   /* the ghosts' gradients and normals from their sources: vectors map with J */
   rhod_ghosts_map_vector(p, m->gC);
   rhod_ghosts_map_vector(p, m->nrm);
@@ -179,12 +239,117 @@ void rhod_mp_pass_colour(rhod_mp *m, rhod_particles *p, const rhod_cells *c) {
 /* Pass 2: continuity (paper 000 Eq. 1), momentum (Eq. 2 with paper 001 Eq. 5's switch),
  * viscosity (paper 001 Eq. 6), the CSF curvature and force (paper 001 Eqs. 7 and 10) and
  * the shifting velocity (paper 000 Eqs. 4-7). */
+#define MAIN_PARAMS                                                                                \
+  rhod_grid G, const int32_t *CS, long st, const real *x, const real *y, const real *dx,           \
+      const real *rho, const real *ux, const real *uy, const real *P, const real *nu,              \
+      const real *T, const real *pk, const uint8_t *ph, const real *gC, const real *nrm,           \
+      const real *sig, real *kap, real *drho, real *acc, real *vel, real *us, int tensile,         \
+      int surface, real ratio, real hfac, real delta, real eta2, real xi_shift, real xi_rep,       \
+      real rep_n, real xi_rif, real gxb, real gyb, real alpha, real visc, long nxr, long nyr
+#define MAIN_ARGS                                                                                  \
+  G, CS, st, x, y, dx, rho, ux, uy, P, nu, T, pk, ph, gC, nrm, sig, kap, drho, acc, vel, us,       \
+      tensile, surface, ratio, hfac, delta, eta2, xi_shift, xi_rep, rep_n, xi_rif, gxb, gyb,       \
+      alpha, visc, nxr, nyr
+
+/* The main pass's gather of particle i; kern and rep2 (the repulsive term's n = 2) are
+ * constants in the host build's specialised copies, so that the lanes vectorise. */
+PARTICLE_BODY void main_particle(long i, MAIN_PARAMS, real dt, const int kern, const int rep2) {
+  const real *kx = pk + RHOD_MP_PK_X * st, *ky = pk + RHOD_MP_PK_Y * st,
+             *kV = pk + RHOD_MP_PK_V * st, *kP = pk + RHOD_MP_PK_P * st,
+             *kux = pk + RHOD_MP_PK_UX * st, *kuy = pk + RHOD_MP_PK_UY * st,
+             *krho = pk + RHOD_MP_PK_RHO * st, *km = pk + RHOD_MP_PK_M * st,
+             *knu = pk + RHOD_MP_PK_NU * st, *kph = pk + RHOD_MP_PK_PH * st, *knx = pk + nxr * st,
+             *kny = pk + nyr * st;
+  const real xi = x[i], yi = y[i], Ri = ratio * dx[i], iR = 1 / Ri, R2 = Ri * Ri;
+  const real iR2 = iR * iR, iR3 = iR2 * iR;
+  const real h = hfac * Ri, eta2h = eta2 * h * h;
+  const real rhoi = rho[i], Pi = P[i], uxi = ux[i], uyi = uy[i], nui = nu[i];
+  const int pi = ph[i];
+  const real phi = (real)pi, ci = T[RHOD_MP_TAB_C * MAXP + pi];
+  /* paper 001 Eq. 5: the + form where p_i >= 0, the - form where p_i < 0 (tensile on) */
+  const real sgn = !tensile || Pi >= 0 ? 1 : -1;
+  const real Wdx = rhod_Wq(kern, dx[i] * iR) * iR2; /* W(dx), paper 000 Eq. 6 */
+  const real nxi = surface ? nrm[2 * i] : 0, nyi = surface ? nrm[2 * i + 1] : 0;
+  const real reli = nxi != 0 || nyi != 0 ? 1 : 0;
+  real RHOD_LANES(s_div), RHOD_LANES(s_dif), RHOD_LANES(s_apx), RHOD_LANES(s_apy),
+      RHOD_LANES(s_avx), RHOD_LANES(s_avy), RHOD_LANES(s_kn), RHOD_LANES(s_kd), RHOD_LANES(s_sx),
+      RHOD_LANES(s_sy), RHOD_LANES(s_fx), RHOD_LANES(s_fy);
+  RHOD_FOR_ROWS(G, CS, xi, yi, Ri, k0, k1, kv) {
+    RHOD_FOR_LANES(k0, kv, k) {
+      const real rx = xi - kx[k], ry = yi - ky[k], r2 = rx * rx + ry * ry;
+      if (!(r2 < R2 && r2 > 0))
+        continue;
+      const real r = sqrt(r2), q = r * iR;
+      const real dW = rhod_dWq(kern, q) * iR3, dWr = dW / r;
+      const real gwx = dWr * rx, gwy = dWr * ry; /* grad W_ij */
+      const real Vj = kV[k], rhoj = krho[k];
+      const real same = kph[k] == phi ? 1 : 0;
+      const real uijx = uxi - kux[k], uijy = uyi - kuy[k];
+      /* paper 000 Eq. 1, first sum: rho_i (u_i - u_j) . grad W_ij V_j (all phases) */
+      RHOD_LANE(s_div) += rhod_mp_div_term(rhoi, uijx * gwx + uijy * gwy, Vj);
+      /* paper 000 Eq. 1, delta-SPH diffusion: the same phase only */
+      RHOD_LANE(s_dif) += same * rhod_mp_diffusion(delta, ci, rhoi, rhoj, dW, Vj);
+      /* paper 000 Eq. 2 (paper 001 Eq. 5): -(p_j +- p_i) V_j / rho_i grad W_ij */
+      const real pc = -(kP[k] + sgn * Pi) * Vj / rhoi;
+      RHOD_LANE(s_apx) += pc * gwx;
+      RHOD_LANE(s_apy) += pc * gwy;
+      /* paper 001 Eq. 6, all phases */
+      const real vc = visc * rhod_mp_visc_coef(km[k], nui, knu[k], rhoi, rhoj,
+                                               uijx * rx + uijy * ry, r2, eta2h);
+      RHOD_LANE(s_avx) += vc * gwx;
+      RHOD_LANE(s_avy) += vc * gwy;
+      /* paper 001 Eq. 10 over the neighbours with a reliable normal */
+      const real nxj = knx[k], nyj = kny[k];
+      const real relj = reli * (nxj != 0 || nyj != 0 ? 1 : 0);
+      RHOD_LANE(s_kn) += relj * Vj * ((nxi - nxj) * gwx + (nyi - nyj) * gwy);
+      /* D_i: the scalar (001 Eq. 10's TYPO prints a vector) */
+      RHOD_LANE(s_kd) += relj * Vj * r * fabs(dW);
+      /* paper 000 Eq. 7: sum_j V_j (1 + f_ij) grad W_ij, f_ij of Eq. 6 ... */
+      const real wq = rhod_Wq(kern, q) * iR2 / Wdx;
+      const real f = rep2 ? xi_rep * wq * wq : rhod_mp_rep(xi_rep, wq, 1, rep_n);
+      RHOD_LANE(s_sx) += Vj * (1 + f) * gwx;
+      RHOD_LANE(s_sy) += Vj * (1 + f) * gwy;
+      /* ... and the RIF's sum over j not in chi_i */
+      RHOD_LANE(s_fx) += (1 - same) * Vj * gwx;
+      RHOD_LANE(s_fy) += (1 - same) * Vj * gwy;
+    }
+    RHOD_END_LANES
+  }
+  RHOD_END_ROWS
+  drho[i] = RHOD_LANES_SUM(s_div) + RHOD_LANES_SUM(s_dif);
+  real ax = RHOD_LANES_SUM(s_apx) + RHOD_LANES_SUM(s_avx) + gxb;
+  real ay = RHOD_LANES_SUM(s_apy) + RHOD_LANES_SUM(s_avy) + gyb;
+  if (surface) {
+    const real kn = RHOD_LANES_SUM(s_kn), kd = RHOD_LANES_SUM(s_kd);
+    real kap_i = 0;
+    if (reli != 0 && kd > 0) {
+      kap_i = -RHOD_DIM * kn / kd; /* paper 001 Eq. 10 */
+      /* paper 001 Eq. 7 with n |grad C| = grad C: a = -(1/rho_i) sigma kappa grad C */
+      const real s = -sig[i] * kap_i / rhoi;
+      ax += s * gC[2 * i];
+      ay += s * gC[2 * i + 1];
+    }
+    kap[i] = kap_i;
+  }
+  acc[2 * i] = ax;
+  acc[2 * i + 1] = ay;
+  /* paper 000 Eqs. 4 and 7: x moves with u + u_s */
+  const real sx = RHOD_LANES_SUM(s_sx), sy = RHOD_LANES_SUM(s_sy);
+  const real fx = RHOD_LANES_SUM(s_fx), fy = RHOD_LANES_SUM(s_fy);
+  const real usx = rhod_mp_shift(xi_shift, h, dt, sx + xi_rif * alpha * fx);
+  const real usy = rhod_mp_shift(xi_shift, h, dt, sy + xi_rif * alpha * fy);
+  us[2 * i] = usx;
+  us[2 * i + 1] = usy;
+  vel[2 * i] = uxi + usx;
+  vel[2 * i + 1] = uyi + usy;
+}
+
 void rhod_mp_pass_main(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt) {
-  const long n = (long)p->n;
+  const long n = (long)p->n, st = (long)p->cap;
   const rhod_grid G = c->g;
-  const int32_t *CS = c->start, *CI = c->idx;
-  const real *x = p->x, *y = p->y, *dx = p->dx, *rho = p->rho, *mass = p->m, *ux = p->ux,
-             *uy = p->uy, *V = m->V, *P = m->P, *T = m->tab;
+  const int32_t *CS = c->start;
+  const real *x = p->x, *y = p->y, *dx = p->dx, *rho = p->rho, *ux = p->ux, *uy = p->uy, *P = m->P,
+             *nu = m->nu, *T = m->tab, *pk = m->pk;
   const uint8_t *ph = p->phase;
   const real *gC = m->gC, *nrm = m->nrm, *sig = m->sig;
   real *kap = m->kap, *drho = m->drho, *acc = m->acc, *vel = m->vel, *us = m->us;
@@ -194,94 +359,43 @@ void rhod_mp_pass_main(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real 
   const real xi_shift = q_->xi_shift, xi_rep = q_->xi_rep, rep_n = q_->rep_n, xi_rif = q_->xi_rif,
              gxb = q_->gx, gyb = q_->gy;
   const real alpha = 1; /* regular particles (paper 000 Eq. 7, Fig. 11) */
-  int visc = 0;
+  int visc_on = 0;
   for (int k = 0; k < q_->nphase; k++)
-    visc |= q_->ph[k].mu > 0;
+    visc_on |= q_->ph[k].mu > 0;
+  const real visc = visc_on ? 1 : 0;
+  /* the normals' rows exist with surface tension only: elsewhere read the x row (any
+   * row will do: every use is multiplied by reli = 0) */
+  const long nxr = surface ? RHOD_MP_PK_NX : RHOD_MP_PK_X,
+             nyr = surface ? RHOD_MP_PK_NY : RHOD_MP_PK_X;
+  const int rep2 = rep_n == 2;
+  (void)rep2;
+#ifdef RHOD_OFFLOAD
+  RHOD_GATHER_LOOP
+  for (long i = 0; i < n; i++)
+    main_particle(i, MAIN_ARGS, dt, kern, 0);
+#else
   RHOD_GATHER_LOOP
   for (long i = 0; i < n; i++) {
-    const real xi = x[i], yi = y[i], Ri = ratio * dx[i], iR = 1 / Ri, R2 = Ri * Ri;
-    const real h = hfac * Ri, eta2h = eta2 * h * h;
-    const real rhoi = rho[i], Pi = P[i], uxi = ux[i], uyi = uy[i];
-    const int pi = ph[i];
-    const real ci = T[RHOD_MP_TAB_C * MAXP + pi], nui = T[RHOD_MP_TAB_MU * MAXP + pi] / rhoi;
-    /* paper 001 Eq. 5: the + form where p_i >= 0, the - form where p_i < 0 (tensile on) */
-    const int plus = !tensile || Pi >= 0;
-    const real Wdx = rhod_Wq(kern, dx[i] * iR) * iR * iR; /* W(dx), paper 000 Eq. 6 */
-    const real nxi = surface ? nrm[2 * i] : 0, nyi = surface ? nrm[2 * i + 1] : 0;
-    const int reli = nxi != 0 || nyi != 0;
-    real dr_div = 0, dr_dif = 0, apx = 0, apy = 0, avx = 0, avy = 0, kn = 0, kd = 0;
-    real sx = 0, sy = 0, fx = 0, fy = 0;
-    RHOD_FOR_NEIGHBOURS(G, CS, CI, xi, yi, Ri, j) {
-      const real rx = xi - x[j], ry = yi - y[j], r2 = rx * rx + ry * ry;
-      if (!(r2 < R2 && r2 > 0))
-        continue;
-      const real r = sqrt(r2), q = r * iR;
-      const real dW = rhod_dWq(kern, q) * iR * iR * iR, dWr = dW / r;
-      const real gwx = dWr * rx, gwy = dWr * ry; /* grad W_ij */
-      const int pj = ph[j];
-      const real Vj = V[j], rhoj = rho[j];
-      const real uijx = uxi - ux[j], uijy = uyi - uy[j];
-      /* paper 000 Eq. 1, first sum: rho_i (u_i - u_j) . grad W_ij V_j (all phases) */
-      dr_div += rhod_mp_div_term(rhoi, uijx * gwx + uijy * gwy, Vj);
-      /* paper 000 Eq. 1, delta-SPH diffusion: the same phase only */
-      if (pj == pi)
-        dr_dif += rhod_mp_diffusion(delta, ci, rhoi, rhoj, dW, Vj);
-      /* paper 000 Eq. 2 (paper 001 Eq. 5): -(p_j +- p_i) V_j / rho_i grad W_ij */
-      const real pc = rhod_mp_press_coef(Pi, P[j], Vj, rhoi, plus);
-      apx += pc * gwx;
-      apy += pc * gwy;
-      if (visc) { /* paper 001 Eq. 6, all phases */
-        const real nuj = T[RHOD_MP_TAB_MU * MAXP + pj] / rhoj;
-        const real vc =
-            rhod_mp_visc_coef(mass[j], nui, nuj, rhoi, rhoj, uijx * rx + uijy * ry, r2, eta2h);
-        avx += vc * gwx;
-        avy += vc * gwy;
-      }
-      if (reli) { /* paper 001 Eq. 10 over the neighbours with a reliable normal */
-        const real nxj = nrm[2 * j], nyj = nrm[2 * j + 1];
-        if (nxj != 0 || nyj != 0) {
-          kn += Vj * ((nxi - nxj) * gwx + (nyi - nyj) * gwy);
-          kd += Vj * r * fabs(dW); /* D_i: the scalar (001 Eq. 10's TYPO prints a vector) */
-        }
-      }
-      /* paper 000 Eq. 7: sum_j V_j (1 + f_ij) grad W_ij, f_ij of Eq. 6 ... */
-      const real f = rhod_mp_rep(xi_rep, rhod_Wq(kern, q) * iR * iR, Wdx, rep_n);
-      sx += Vj * (1 + f) * gwx;
-      sy += Vj * (1 + f) * gwy;
-      if (pj != pi) { /* ... and the RIF's sum over j not in chi_i */
-        fx += Vj * gwx;
-        fy += Vj * gwy;
-      }
-    }
-    RHOD_END_NEIGHBOURS
-    drho[i] = dr_div + dr_dif;
-    real ax = apx + avx + gxb, ay = apy + avy + gyb;
-    if (surface) {
-      real kap_i = 0;
-      if (reli && kd > 0) {
-        kap_i = -RHOD_DIM * kn / kd; /* paper 001 Eq. 10 */
-        /* paper 001 Eq. 7 with n |grad C| = grad C: a = -(1/rho_i) sigma kappa grad C */
-        const real s = -sig[i] * kap_i / rhoi;
-        ax += s * gC[2 * i];
-        ay += s * gC[2 * i + 1];
-      }
-      kap[i] = kap_i;
-    }
-    acc[2 * i] = ax;
-    acc[2 * i + 1] = ay;
-    /* paper 000 Eqs. 4 and 7: x moves with u + u_s */
-    const real usx = rhod_mp_shift(xi_shift, h, dt, sx + xi_rif * alpha * fx);
-    const real usy = rhod_mp_shift(xi_shift, h, dt, sy + xi_rif * alpha * fy);
-    us[2 * i] = usx;
-    us[2 * i + 1] = usy;
-    vel[2 * i] = uxi + usx;
-    vel[2 * i + 1] = uyi + usy;
+    if (kern == RHOD_KERNEL_WENDLAND_C4 && rep2)
+      main_particle(i, MAIN_ARGS, dt, RHOD_KERNEL_WENDLAND_C4, 1);
+    else if (kern == RHOD_KERNEL_QUINTIC && rep2)
+      main_particle(i, MAIN_ARGS, dt, RHOD_KERNEL_QUINTIC, 1);
+    else
+      main_particle(i, MAIN_ARGS, dt, kern, 0);
   }
+#endif
 }
 
+void rhod_mp_pack(rhod_mp *m, const rhod_particles *p, const rhod_cells *c) { pack_state(m, p, c); }
+
 void rhod_mp_rhs(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt) {
-  if (m->surface)
+  pack_state(m, p, c);
+  if (m->surface) {
     rhod_mp_pass_colour(m, p, c);
+    const long nt = (long)(p->n + p->ng), st = (long)p->cap;
+    rhod_cells_pack(c, nt, m->pk + RHOD_MP_PK_NX * st, m->nrm, 2, 0);
+    rhod_cells_pack(c, nt, m->pk + RHOD_MP_PK_NY * st, m->nrm, 2, 1);
+  }
   rhod_mp_pass_main(m, p, c, dt);
   /* the largest shift per step in particle sizes (logged; multiphase.md: no cap) */
   const long n = (long)p->n;

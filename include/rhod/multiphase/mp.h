@@ -58,6 +58,28 @@ enum {
  * for equal densities). */
 #define RHOD_MP_NORMAL_EPS ((real)0.01)
 
+/* Rows of rhod_mp.pk: the neighbour-side fields of the gathers copied into the cells'
+ * order (rhod_cells_pack; row r of the particle at sorted place k at pk[r * cap + k]), so
+ * that the inner loops read them contiguously and vectorise (RHOD_FOR_LANES). The colour
+ * pass reads the rows up to COL; the normals are packed after it, for the main pass. */
+enum {
+  RHOD_MP_PK_X,
+  RHOD_MP_PK_Y,
+  RHOD_MP_PK_V,
+  RHOD_MP_PK_P,
+  RHOD_MP_PK_UX,
+  RHOD_MP_PK_UY,
+  RHOD_MP_PK_RHO,
+  RHOD_MP_PK_M,
+  RHOD_MP_PK_NU,  /* kinematic viscosity mu / rho */
+  RHOD_MP_PK_PH,  /* the phase index, as a real */
+  RHOD_MP_PK_COL, /* the phase's colour */
+  RHOD_MP_PK_ROWS_PLAIN,
+  RHOD_MP_PK_NX = RHOD_MP_PK_ROWS_PLAIN, /* with surface tension: the normals */
+  RHOD_MP_PK_NY,
+  RHOD_MP_PK_ROWS
+};
+
 typedef struct {
   rhod_mp_params prm;
   real hfac;     /* h / R: 1/2 Wendland, 1/3 quintic */
@@ -78,6 +100,8 @@ typedef struct {
   real *sig;              /* surface tension of i's interface (0: none in reach) */
   real *kap;              /* curvature (001 Eq. 10), 0 where the normal is unreliable */
   real *us;               /* shifting velocity u_s (paper 000 Eq. 7), 2 */
+  real *nu, *col;         /* kinematic viscosity and colour (fluid and ghosts) */
+  real *pk;               /* neighbour-side rows in cell order (RHOD_MP_PK_*) */
   real *drho, *acc, *vel; /* d rho/dt (1), du/dt (2), dx/dt = u + u_s (2) */
 } rhod_mp;
 
@@ -97,8 +121,10 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p);
  * fills drho (1), acc (2: du/dt) and vel (2: dx/dt = u + u_s) for the fluid [0, n).
  * dt is the step of the shifting velocity (Eq. 7); dt <= 0 gives u_s = 0. */
 void rhod_mp_rhs(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt);
-/* The passes of rhod_mp_rhs, in its order (public for tests): the colour gradient,
- * normal and sigma (only when m->surface), the ghosts' copies of them, then the rest. */
+/* The passes of rhod_mp_rhs, in its order (public for tests and benchmarks): the rows in
+ * cell order (rhod_mp_pack), the colour gradient, normal and sigma (only when m->surface),
+ * the ghosts' copies of them, the normals' rows, then the rest. */
+void rhod_mp_pack(rhod_mp *m, const rhod_particles *p, const rhod_cells *c);
 void rhod_mp_pass_colour(rhod_mp *m, rhod_particles *p, const rhod_cells *c);
 void rhod_mp_pass_main(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt);
 /* The time step of paper 001 Eqs. 14-17 (the four limits; |a_i| from the last rhs' acc);
