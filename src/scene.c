@@ -52,8 +52,19 @@ typedef struct {
 } y_rotation;
 
 typedef struct {
+  double U, UI, y[2], width, spread, L;
+} y_shear_layer;
+
+typedef struct {
+  double U, R;
+  double *center;
+} y_droplet;
+
+typedef struct {
   y_taylor_green *taylor_green;
   y_rotation *rotation;
+  y_shear_layer *shear_layer;
+  y_droplet *droplet_oscillation;
 } y_initial;
 
 typedef struct {
@@ -374,10 +385,31 @@ static const cyaml_schema_field_t f_rotation[] = {
     CYAML_FIELD_END,
 };
 
+static const cyaml_schema_field_t f_shear_layer[] = {
+    NUM("U", y_shear_layer, U),
+    NUM("UI", y_shear_layer, UI),
+    VEC("y", 0, y_shear_layer, y),
+    NUM("width", y_shear_layer, width),
+    NUM("spread", y_shear_layer, spread),
+    NUM("L", y_shear_layer, L),
+    CYAML_FIELD_END,
+};
+
+static const cyaml_schema_field_t f_droplet[] = {
+    NUM("U", y_droplet, U),
+    NUM("R", y_droplet, R),
+    VEC("center", OPT, y_droplet, center),
+    CYAML_FIELD_END,
+};
+
 static const cyaml_schema_field_t f_initial[] = {
     CYAML_FIELD_MAPPING_PTR("taylor_green", OPT | CYAML_FLAG_FLOW, y_initial, taylor_green,
                             f_taylor_green),
     CYAML_FIELD_MAPPING_PTR("rotation", OPT | CYAML_FLAG_FLOW, y_initial, rotation, f_rotation),
+    CYAML_FIELD_MAPPING_PTR("shear_layer", OPT | CYAML_FLAG_FLOW, y_initial, shear_layer,
+                            f_shear_layer),
+    CYAML_FIELD_MAPPING_PTR("droplet_oscillation", OPT | CYAML_FLAG_FLOW, y_initial,
+                            droplet_oscillation, f_droplet),
     CYAML_FIELD_END,
 };
 
@@ -1966,9 +1998,35 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       const y_initial *in = y->initial;
       char ip[192];
       snprintf(ip, sizeof ip, "%s.initial", path);
-      if (!!in->taylor_green + !!in->rotation != 1)
-        return fail(c, ip, "needs exactly one of taylor_green, rotation");
-      if (in->taylor_green) {
+      if (!!in->taylor_green + !!in->rotation + !!in->shear_layer + !!in->droplet_oscillation != 1)
+        return fail(c, ip,
+                    "needs exactly one of taylor_green, rotation, shear_layer, "
+                    "droplet_oscillation");
+      if (in->shear_layer) {
+        const y_shear_layer *k = in->shear_layer;
+        const double len[3] = {k->width, k->spread, k->L};
+        const char *const key[3] = {"width", "spread", "L"};
+        for (int j = 0; j < 3; j++)
+          if (!(len[j] > 0)) {
+            snprintf(ip, sizeof ip, "%s.initial.shear_layer.%s", path, key[j]);
+            return fail(c, ip, "must be > 0");
+          }
+        b->flow = RHOD_FLOW_SHEAR_LAYER;
+        b->flow_U = k->U, b->flow_UI = k->UI, b->flow_L = k->L;
+        b->flow_y[0] = k->y[0], b->flow_y[1] = k->y[1];
+        b->flow_width = k->width, b->flow_spread = k->spread;
+      } else if (in->droplet_oscillation) {
+        const y_droplet *k = in->droplet_oscillation;
+        snprintf(ip, sizeof ip, "%s.initial.droplet_oscillation.R", path);
+        if (!(k->R > 0))
+          return fail(c, ip, "must be > 0");
+        b->flow = RHOD_FLOW_DROPLET;
+        b->flow_U = k->U, b->flow_R = k->R;
+        if (k->center)
+          memcpy(b->flow_center, k->center, sizeof b->flow_center);
+        else
+          b->flow_center[0] = 0.5 * (lo[0] + hi[0]), b->flow_center[1] = 0.5 * (lo[1] + hi[1]);
+      } else if (in->taylor_green) {
         snprintf(ip, sizeof ip, "%s.initial.taylor_green.L", path);
         if (!(in->taylor_green->L > 0))
           return fail(c, ip, "must be > 0");
@@ -2340,9 +2398,22 @@ domain:
         ry_node *k = tb_coll(&t, in, "taylor_green", RY_MAP, 1);
         tb_num(&t, k, "U", fb->flow_U);
         tb_num(&t, k, "L", fb->flow_L);
-      } else {
+      } else if (fb->flow == RHOD_FLOW_ROTATION) {
         ry_node *k = tb_coll(&t, in, "rotation", RY_MAP, 1);
         tb_num(&t, k, "omega", fb->flow_omega);
+        tb_vec(&t, k, "center", fb->flow_center);
+      } else if (fb->flow == RHOD_FLOW_SHEAR_LAYER) {
+        ry_node *k = tb_coll(&t, in, "shear_layer", RY_MAP, 1);
+        tb_num(&t, k, "U", fb->flow_U);
+        tb_num(&t, k, "UI", fb->flow_UI);
+        tb_vec(&t, k, "y", fb->flow_y);
+        tb_num(&t, k, "width", fb->flow_width);
+        tb_num(&t, k, "spread", fb->flow_spread);
+        tb_num(&t, k, "L", fb->flow_L);
+      } else {
+        ry_node *k = tb_coll(&t, in, "droplet_oscillation", RY_MAP, 1);
+        tb_num(&t, k, "U", fb->flow_U);
+        tb_num(&t, k, "R", fb->flow_R);
         tb_vec(&t, k, "center", fb->flow_center);
       }
     }
@@ -2760,8 +2831,10 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
   for (unsigned i = 0; i < s->n_fluid; i++) {
     const rhod_fluid_block *b = &s->fluid[i];
     double flow = 0; /* the initial flow's largest speed */
-    if (b->flow == RHOD_FLOW_TAYLOR_GREEN)
-      flow = fabs(b->flow_U);
+    if (b->flow == RHOD_FLOW_TAYLOR_GREEN || b->flow == RHOD_FLOW_DROPLET)
+      flow = fabs(b->flow_U); /* Eqs. 28-29 stay below U (paper 000) */
+    else if (b->flow == RHOD_FLOW_SHEAR_LAYER)
+      flow = hypot(b->flow_U, 2 * b->flow_UI); /* |tanh - tanh - 1| <= 1 for y1 < y2 */
     else if (b->flow == RHOD_FLOW_ROTATION) {
       double lo[2], hi[2];
       shape_bbox(&b->shape, lo, hi);

@@ -146,6 +146,22 @@ void rhod_sim_initial_flow(const rhod_sim *s, unsigned b, double x, double y, do
     P = rotation_pressure(rho0, w, B->shape.max[0] - B->shape.min[0],
                           B->shape.max[1] - B->shape.min[1], x - B->shape.min[0],
                           y - B->shape.min[1]);
+  } else if (B->flow == RHOD_FLOW_SHEAR_LAYER) {
+    /* paper 000 Eq. 27 (after Lecoanet et al. 2016): two tanh shear layers at y1, y2 and
+     * a vertical perturbation of wavelength L localised at both; P unchanged */
+    const double y1 = B->flow_y[0], y2 = B->flow_y[1], w = B->flow_width, s2 = B->flow_spread;
+    u += B->flow_U * (tanh((y - y1) / w) - tanh((y - y2) / w) - 1);
+    v += B->flow_UI * sin(2 * M_PI * x / B->flow_L) *
+         (exp(-(y - y1) * (y - y1) / (s2 * s2)) + exp(-(y - y2) * (y - y2) / (s2 * s2)));
+  } else if (B->flow == RHOD_FLOW_DROPLET) {
+    /* paper 000 Eqs. 28-29 (after Adami et al. 2010), x and y from the centre; divergence
+     * free; 0 at the centre (the r -> 0 limit of x y^2/r and y x^2/r) */
+    const double X = x - B->flow_center[0], Y = y - B->flow_center[1], R = B->flow_R;
+    const double r = hypot(X, Y), e = exp(-r / R);
+    if (r > 0) {
+      u += B->flow_U * X / R * (1 - Y * Y / (R * r)) * e;
+      v -= B->flow_U * Y / R * (1 - X * X / (R * r)) * e;
+    }
   }
   *u_out = u, *v_out = v, *P_out = P;
 }

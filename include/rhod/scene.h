@@ -31,17 +31,30 @@ typedef enum {
   RHOD_FLOW_NONE = 0,
   RHOD_FLOW_TAYLOR_GREEN, /* u = U sin(kx) cos(ky), v = -U cos(kx) sin(ky), k = 2 pi / L,
                              P = rho0 U^2/4 (cos 2kx + cos 2ky) */
-  RHOD_FLOW_ROTATION      /* rigid rotation u = omega x (x - center) with the pressure
+  RHOD_FLOW_ROTATION,     /* rigid rotation u = omega x (x - center) with the pressure
                              series of paper 002 Eq. 30 (rect blocks) */
+  RHOD_FLOW_SHEAR_LAYER,  /* Kelvin-Helmholtz double shear layer, paper 000 Eq. 27:
+                             u = U [tanh((y - y1)/w) - tanh((y - y2)/w) - 1],
+                             v = UI sin(2 pi x/L) [exp(-(y - y1)^2/s^2) + exp(-(y - y2)^2/s^2)] */
+  RHOD_FLOW_DROPLET       /* mode-2 droplet oscillation, paper 000 Eqs. 28-29, about center:
+                             u = U x/R (1 - y^2/(R r)) exp(-r/R),
+                             v = -U y/R (1 - x^2/(R r)) exp(-r/R) */
 } rhod_flow_kind;
 
 /* A block of fluid filled with a square lattice of spacing particles.dx. */
 typedef struct {
   rhod_shape shape;
-  rhod_flow_kind flow;     /* initial.taylor_green / initial.rotation */
+  rhod_flow_kind flow;     /* initial.taylor_green / rotation / shear_layer /
+                              droplet_oscillation */
   double flow_U, flow_L;   /* taylor_green: amplitude [m/s], period [m] */
   double flow_omega;       /* rotation: angular velocity [1/s], > 0 counter-clockwise */
-  double flow_center[2];   /* rotation: centre [m], default the block's centre */
+  double flow_center[2];   /* rotation, droplet_oscillation: centre [m], default the block's
+                              centre */
+  double flow_UI;          /* shear_layer: perturbation amplitude [m/s]; U is flow_U, L flow_L */
+  double flow_y[2];        /* shear_layer: the interfaces y1, y2 [m] */
+  double flow_width;       /* shear_layer: tanh width w [m] */
+  double flow_spread;      /* shear_layer: Gaussian width s of the perturbation [m] */
+  double flow_R;           /* droplet_oscillation: radius R of Eqs. 28-29 [m]; U is flow_U */
   double velocity[2];      /* initial velocity [m/s], default 0 */
   rhod_init_kind pressure; /* uniform (P = 0) or hydrostatic (paper 002 Sec. VI A,
                               free surface at `surface`) */
