@@ -12,6 +12,7 @@
 #include "rhod/rhodsph/scheme.h"
 #include "rhod/rhodsph/sph.h"
 #include "rhod/sim.h"
+#include "test_run_util.h"
 #include "test_scene_util.h"
 #include <math.h>
 #include <stdio.h>
@@ -223,44 +224,8 @@ static void test_mixed_size_neighbours(void) {
 /* ------------------------------------------------------------------------------------ */
 /* simulations set up from scene text                                                    */
 
-typedef struct {
-  rhod_scene *sc;
-  rhod_sim *sim; /* on the heap: the store keeps pointers into it */
-} run;
-
-/* Loads the scene text (written to a file named after tag) and sets up the run. */
 static int run_open(run *r, const char *tag, const char *yaml) {
-  char path[256], err[1024] = "";
-  snprintf(path, sizeof path, "test_apr_%s.yaml", tag);
-  FILE *f = fopen(path, "w");
-  if (!f)
-    return 0;
-  fputs(yaml, f);
-  fclose(f);
-  r->sc = NULL;
-  r->sim = NULL;
-  int st = rhod_scene_load(path, NULL, 0, &r->sc, err, sizeof err);
-  remove(path);
-  if (st != RHOD_OK) {
-    fprintf(stderr, "\n%s: %s\n", tag, err);
-    return 0;
-  }
-  r->sim = calloc(1, sizeof *r->sim);
-  st = rhod_sim_init(r->sim, r->sc, err, sizeof err);
-  if (st != RHOD_OK) {
-    fprintf(stderr, "\n%s: %s\n", tag, err);
-    return 0;
-  }
-  return 1;
-}
-
-static void run_close(run *r) {
-  if (r->sim) {
-    rhod_sim_free(r->sim);
-    free(r->sim);
-  }
-  if (r->sc)
-    rhod_scene_free(r->sc);
+  return run_open_in(r, "test_apr", tag, yaml);
 }
 
 /* Sums over the fluid, in long double, of m, m u, m v, m (x v - y u), m |u|^2 / 2. */

@@ -153,9 +153,10 @@ static void patch(unsigned char *b, size_t len, size_t off, const void *v, size_
   memcpy(b + len - 8, &h, 8);
 }
 
-/* Offsets in a version-5 file: magic 8, version 4, precision 4, then the records
- * (src/checkpoint.c: 13 eight-byte values, the picture range, then probes_bytes). */
-enum { OFF_T = 16, OFF_NEXT_OUT = 24, OFF_PROBES_BYTES = 136, OFF_NSNAP = 144 };
+/* Offsets in a version-6 file without extras: magic 8, version 4, precision 4, then the
+ * records (src/checkpoint.c: 13 eight-byte values, the picture range, nextra, then
+ * probes_bytes). */
+enum { OFF_T = 16, OFF_NEXT_OUT = 24, OFF_NEXTRA = 136, OFF_PROBES_BYTES = 140, OFF_NSNAP = 148 };
 
 static int parse_patched(size_t off, const void *v, size_t n, char *err, size_t len) {
   rhod_checkpoint ck;
@@ -210,6 +211,38 @@ static void test_patch_huge_probes_bytes(void) {
   expect_field(parse_patched(OFF_PROBES_BYTES, &v, 8, err, sizeof err), err, "probes_bytes");
 }
 
+static void test_patch_too_many_extras(void) {
+  char err[512];
+  const int32_t v = RHOD_CK_MAX_EXTRAS + 1;
+  expect_field(parse_patched(OFF_NEXTRA, &v, 4, err, sizeof err), err, "nextra");
+}
+
+/* A scheme's named scalars (version 6) come back by name and value, all RHOD_CK_MAX_EXTRAS
+ * of them; a name of 32 bytes or more cannot be stored. */
+static void test_extras_round_trip(void) {
+  rhod_checkpoint ck;
+  rhod_particles p;
+  base(&ck, &p);
+  ck.nextra = RHOD_CK_MAX_EXTRAS;
+  for (int i = 0; i < ck.nextra; i++) {
+    snprintf(ck.extra_name[i], sizeof ck.extra_name[i], "scalar_%d", i);
+    ck.extra[i] = 0.5 + i;
+  }
+  char err[512];
+  CU_ASSERT_FATAL(rhod_checkpoint_write(ckpath, &ck, &p, err, sizeof err) == RHOD_OK);
+  rhod_particles_free(&p);
+  rhod_checkpoint back;
+  CU_ASSERT_EQUAL_FATAL(rhod_checkpoint_read(ckpath, &back, err, sizeof err), RHOD_OK);
+  CU_ASSERT_EQUAL(back.nextra, RHOD_CK_MAX_EXTRAS);
+  for (int i = 0; i < back.nextra; i++) {
+    char want[32];
+    snprintf(want, sizeof want, "scalar_%d", i);
+    CU_ASSERT_STRING_EQUAL(back.extra_name[i], want);
+    CU_ASSERT_EQUAL(back.extra[i], 0.5 + i);
+  }
+  rhod_checkpoint_free(&back);
+}
+
 int main(void) {
   if (!mkdtemp(dir))
     return 2;
@@ -249,6 +282,8 @@ int main(void) {
       {"patched: negative nsnap", test_patch_negative_nsnap},
       {"patched: 2 TiB probes.csv", test_patch_absurd_probes_bytes},
       {"patched: probes.csv length 2^64-1", test_patch_huge_probes_bytes},
+      {"patched: more extras than a checkpoint holds", test_patch_too_many_extras},
+      {"a scheme's named scalars round trip", test_extras_round_trip},
   };
   const int rc = RHOD_RUN_TESTS("checkpoint validation", cases);
   unlink(ckpath);

@@ -11,6 +11,7 @@
 #include "rhod/io.h"
 #include "rhod/scene.h"
 #include "rhod/sim.h"
+#include "test_run_util.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -23,43 +24,8 @@
 #define VTOL 1e-12
 #endif
 
-typedef struct {
-  rhod_scene *sc;
-  rhod_sim *sim;
-} run;
-
 static int run_open(run *r, const char *tag, const char *yaml) {
-  char path[256], err[1024] = "";
-  snprintf(path, sizeof path, "test_initial_flows_%s.yaml", tag);
-  FILE *f = fopen(path, "w");
-  if (!f)
-    return 0;
-  fputs(yaml, f);
-  fclose(f);
-  r->sc = NULL;
-  r->sim = NULL;
-  int st = rhod_scene_load(path, NULL, 0, &r->sc, err, sizeof err);
-  remove(path);
-  if (st != RHOD_OK) {
-    fprintf(stderr, "\n%s: %s\n", tag, err);
-    return 0;
-  }
-  r->sim = calloc(1, sizeof *r->sim);
-  st = rhod_sim_init(r->sim, r->sc, err, sizeof err);
-  if (st != RHOD_OK) {
-    fprintf(stderr, "\n%s: %s\n", tag, err);
-    return 0;
-  }
-  return 1;
-}
-
-static void run_close(run *r) {
-  if (r->sim) {
-    rhod_sim_free(r->sim);
-    free(r->sim);
-  }
-  if (r->sc)
-    rhod_scene_free(r->sc);
+  return run_open_in(r, "test_initial_flows", tag, yaml);
 }
 
 /* The scene as run (sc->yaml) loads back to the same flow parameters and the same text. */

@@ -3,8 +3,8 @@
  * as run (YAML and flattened parameters) and the Eq. 2 warning on c0. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cunit_main.h"
 #include "rhod/scene.h"
+#include "test_scene_load.h"
 
 #include <fcntl.h>
 #include <math.h>
@@ -13,22 +13,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-#define GOOD(name) RHOD_SOURCE_DIR "/tests/scenes/good/" name
-#define BAD(name) RHOD_SOURCE_DIR "/tests/scenes/bad/" name
-
-static rhod_scene *load_ok(const char *path, const char *const *ov, int n) {
-  char err[1024] = "";
-  rhod_scene *s = NULL;
-  int rc = rhod_scene_load(path, ov, n, &s, err, sizeof err);
-  if (rc != RHOD_OK)
-    fprintf(stderr, "\nunexpected failure: %s\n", err);
-  CU_ASSERT_EQUAL(rc, RHOD_OK);
-  CU_ASSERT_PTR_NOT_NULL(s);
-  return s;
-}
-
-#define CLOSE(a, b) CU_ASSERT_DOUBLE_EQUAL((a), (b), 1e-12)
 
 static void test_full_scene(void) {
   rhod_scene *s = load_ok(GOOD("full.yaml"), NULL, 0);
@@ -460,13 +444,6 @@ static void test_as_run_round_trip(void) {
   if (a)
     CU_ASSERT_PTR_NULL(strstr(a->yaml, "min: [0, 0]\n  max"));
   rhod_scene_free(a);
-}
-
-static const char *param(const rhod_param_list *p, const char *key) {
-  for (unsigned i = 0; i < p->n; i++)
-    if (strcmp(p->keys[i], key) == 0)
-      return p->values[i];
-  return NULL;
 }
 
 static void test_params(void) {

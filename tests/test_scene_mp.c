@@ -4,28 +4,14 @@
  * same scene (load, write, load, compare). The malformed files are in test_scene's table. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "cunit_main.h"
 #include "rhod/multiphase/scene.h"
 #include "rhod/scene.h"
+#include "test_scene_load.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define GOOD(name) RHOD_SOURCE_DIR "/tests/scenes/good/" name
-#define CLOSE(a, b) CU_ASSERT_DOUBLE_EQUAL((a), (b), 1e-12)
-
-static rhod_scene *load_ok(const char *path, const char *const *ov, int n) {
-  char err[1024] = "";
-  rhod_scene *s = NULL;
-  int rc = rhod_scene_load(path, ov, n, &s, err, sizeof err);
-  if (rc != RHOD_OK)
-    fprintf(stderr, "\nunexpected failure: %s\n", err);
-  CU_ASSERT_EQUAL(rc, RHOD_OK);
-  CU_ASSERT_PTR_NOT_NULL(s);
-  return s;
-}
 
 static void test_full(void) {
   rhod_scene *s = load_ok(GOOD("multiphase.yaml"), NULL, 0);
@@ -389,13 +375,6 @@ static void test_as_run(void) {
       "edges: [2]}",
       "walls.1={polygon: [[2, 0], [2, 1], [3, 0]], velocity: [0, -1], edges: [0]}"};
   round_trip(GOOD("minimal.yaml"), lid, 2);
-}
-
-static const char *param(const rhod_param_list *p, const char *key) {
-  for (unsigned i = 0; i < p->n; i++)
-    if (strcmp(p->keys[i], key) == 0)
-      return p->values[i];
-  return NULL;
 }
 
 static void test_params(void) {
