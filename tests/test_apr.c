@@ -1098,7 +1098,7 @@ static void test_criteria_1_2(void) {
  * the merged particle's grandchild (criterion 1); the merge keeps mass, momentum,
  * centre of mass and volume, and the merged particles have the size dx exactly. The
  * h/e particle, with no other of its size, is a straggler: it alone is shared out
- * among the fine particles within (1 + e) h/e of it (absorb in kernels/rhod_apr.c),
+ * among the fine particles within (1 + e) h/e of it (absorb in kernels/rhodsph/rhod_apr.c),
  * which the same sums conserve. */
 static void coalesce_groups(rhod_pattern pattern) {
   const int N = rhod_pattern_children(pattern);
@@ -1278,7 +1278,7 @@ static void test_coalesce_run(void) {
 }
 
 /* Criterion 3 for a coalescing candidate is exact: no free-surface particle within
- * 1.25 times the merged particle's support (HYST, kernels/rhod_apr.c). A tank at rest
+ * 1.25 times the merged particle's support (HYST, kernels/rhodsph/rhod_apr.c). A tank at rest
  * refined whole at t = 0 (levels 2, R = 4 dx: R_c = 0.04 m for the merged size) with
  * criterion 3: the two fine rows just deeper than 1.25 R_c = 0.05 m merge back (the rows
  * below them are not asked about here), those within R_c of the surface stay. A test on

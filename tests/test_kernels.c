@@ -318,7 +318,7 @@ static void test_viscous_consistent(void) {
 }
 
 /* The host build runs passes A and C through copies specialised for the scene's
- * switches (kernels/rhod_sph.c); s->generic forces the general copy. Every combination
+ * switches (kernels/rhodsph/rhod_sph.c); s->generic forces the general copy. Every combination
  * of Riemann terms, reconstruction, shifting and viscosity (Eq. 10, and the consistent
  * operator) must give the same right-hand side as the general copy, on a disordered
  * free-surface patch with a pressure and a rotational velocity field. */
@@ -1016,7 +1016,7 @@ static void test_free_surface_square(void) {
 }
 
 /* The free-surface region of Eq. 26 (rhod_sph_pass_region, our reading of Ref. 55 in
- * kernels/rhod_sph.c): n~_i the W-weighted mean of the free-surface normals in the
+ * kernels/rhodsph/rhod_sph.c): n~_i the W-weighted mean of the free-surface normals in the
  * support, sigma_i = 1 - d_i / R_i with d_i the distance to the nearest free-surface
  * particle. On a 24 x 16 lattice (R = 4 dx) the middle column k rows below the top has
  * sigma = 1 - k/4 and n~ = (0, 1); on a disordered patch every particle's reg, sigma and
