@@ -452,11 +452,13 @@ void rhod_sim_free(rhod_sim *s) {
   s->fill = NULL;
   if (s->ops && s->ops->free)
     s->ops->free(s);
-  free(s->sch);
-  s->sch = NULL;
   rhod_cells_free(&s->cells);
   rhod_boundary_free(&s->bnd);
+  /* the store frees the scheme's fields through pointers that live in its state: the
+   * state goes last */
   rhod_particles_free(&s->p);
+  free(s->sch);
+  s->sch = NULL;
 }
 
 /* Periodic wrap of the fluid into the box (once per step, before sorting). */
