@@ -72,7 +72,7 @@ cat >"$T/mp.yaml" <<'YAML'
 name: mp_restart
 scheme: {name: multiphase}
 time: {end: 0.05, output_every: 0.005}
-particles: {dx: 0.025, jitter: 0.1}
+particles: {dx: 0.04, jitter: 0.1}
 phases:
   - {name: liquid, rho0: 1, c: 10, mu: 0.05}
   - {name: gas, rho0: 0.5, c: 10, mu: 0.05, gamma: 1}
