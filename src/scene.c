@@ -1182,14 +1182,6 @@ static int check_range(lctx *c, const char *path, double v, double lo, int lo_op
               hi_open ? ")" : "]", v);
 }
 
-#define TRY(expr)                                                                                  \
-  do {                                                                                             \
-    int rc_ = (expr);                                                                              \
-    if (rc_)                                                                                       \
-      return rc_;                                                                                  \
-  } while (0)
-
-static double opt(const double *p, double def) { return p ? *p : def; }
 static int opt_bool(const bool *p, int def) { return p ? (*p ? 1 : 0) : def; }
 
 static double polygon_area(const double (*p)[2], unsigned n) {

@@ -10,6 +10,17 @@
 /* The loading context of src/scene.c (the file, the overrides, the document's tree). */
 typedef struct lctx lctx;
 
+/* Returns the status of expr when it is not RHOD_OK. */
+#define TRY(expr)                                                                                  \
+  do {                                                                                             \
+    int rc_ = (expr);                                                                              \
+    if (rc_)                                                                                       \
+      return rc_;                                                                                  \
+  } while (0)
+
+/* An optional number's value, or its default when absent. */
+static inline double opt(const double *p, double def) { return p ? *p : def; }
+
 /* An error about the value at a dotted path, located at the deepest node of the path the
  * document holds; returns RHOD_ERR_SCENE. */
 int rhod_sl_fail(lctx *c, const char *path, const char *fmt, ...)

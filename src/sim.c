@@ -122,12 +122,14 @@ int rhod_sim_block_at(const rhod_sim *s, double x, double y) {
   return -1;
 }
 
-double rhod_sim_block_top(const rhod_sim *s, unsigned b) {
+double rhod_sim_block_depth(const rhod_sim *s, unsigned b, double x, double y, double *g_out) {
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
   const double g = hypot(sc->gravity[0], sc->gravity[1]);
   const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
-  return B->surface_set ? B->surface : shape_top(&B->shape, ex, ey);
+  const double top = B->surface_set ? B->surface : shape_top(&B->shape, ex, ey);
+  *g_out = g;
+  return top - (x * ex + y * ey);
 }
 
 void rhod_sim_initial_flow(const rhod_sim *s, unsigned b, double x, double y, double rho0,

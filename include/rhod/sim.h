@@ -58,8 +58,9 @@ int rhod_sim_block_at(const rhod_sim *s, double x, double y);
  * plus its analytic flow (fluid.N.initial), and that flow's pressure (0 without one). */
 void rhod_sim_initial_flow(const rhod_sim *s, unsigned b, double x, double y, double rho0,
                            double *u, double *v, double *P);
-/* The free surface's level of block b along -g (fluid.N.surface, or its highest point). */
-double rhod_sim_block_top(const rhod_sim *s, unsigned b);
+/* The depth of (x, y) below block b's free surface along gravity (the surface at
+ * fluid.N.surface, or the block's highest point along -g), and |g| into *g. */
+double rhod_sim_block_depth(const rhod_sim *s, unsigned b, double x, double y, double *g);
 /* Each particle gets the initial state of its block where it stands (ops->initial_state),
  * sizes and ids kept: its block is blk[id] when a table is given, else the block at its
  * place; a particle of no block keeps its fields. With jit > 0 it is first jittered by

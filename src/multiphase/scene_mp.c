@@ -61,15 +61,6 @@ const cyaml_schema_field_t rhod_mp_f_section[] = {
 
 /* ---- checks and defaults ---------------------------------------------------------------- */
 
-#define TRY(expr)                                                                                  \
-  do {                                                                                             \
-    int rc_ = (expr);                                                                              \
-    if (rc_)                                                                                       \
-      return rc_;                                                                                  \
-  } while (0)
-
-static double opt(const double *p, double def) { return p ? *p : def; }
-
 int rhod_mp_phase_index(const rhod_mp_scene *mp, const char *name) {
   for (unsigned k = 0; mp && name && k < mp->n_phases; k++)
     if (strcmp(mp->phases[k].name, name) == 0)

@@ -26,9 +26,9 @@ static void mp_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double
   double u, v, P;
   rhod_sim_initial_flow(s, b, x, y, rho0, &u, &v, &P);
   if (B->pressure == RHOD_INIT_HYDROSTATIC) {
-    const double g = hypot(sc->gravity[0], sc->gravity[1]);
-    const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
-    P += rho0 * g * (rhod_sim_block_top(s, b) - (x * ex + y * ey));
+    double g;
+    const double depth = rhod_sim_block_depth(s, b, x, y, &g);
+    P += rho0 * g * depth;
   }
   const double rho = rhod_mp_density(&m->prm, ph, (real)P);
   p->x[k] = (real)x;

@@ -29,15 +29,13 @@ static void rs_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
   rhod_particles *p = &s->p;
-  const double g = hypot(sc->gravity[0], sc->gravity[1]);
-  const double ex = g > 0 ? -sc->gravity[0] / g : 0, ey = g > 0 ? -sc->gravity[1] / g : 1;
   const double c2 = sc->c0 * sc->c0;
   double P = 0;
   if (B->pressure == RHOD_INIT_HYDROSTATIC) {
     /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1), the free surface
      * at fluid.N.surface (default the block's top along -g) */
-    const double top = rhod_sim_block_top(s, b);
-    const double depth = top - (x * ex + y * ey);
+    double g;
+    const double depth = rhod_sim_block_depth(s, b, x, y, &g);
     P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
   }
   double u, v, Pf;
