@@ -134,7 +134,7 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
 }
 
 /* The rows every gather reads, in the order of the cells' last build (fluid and ghosts). */
-static void pack_state(rhod_mp *m, const rhod_particles *p, const rhod_cells *c) {
+void rhod_mp_pack(rhod_mp *m, const rhod_particles *p, const rhod_cells *c) {
   const long nt = (long)(p->n + p->ng), st = (long)p->cap;
   real *pk = m->pk;
   rhod_cells_pack(c, nt, pk + RHOD_MP_PK_X * st, p->x, 1, 0);
@@ -386,10 +386,8 @@ void rhod_mp_pass_main(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real 
 #endif
 }
 
-void rhod_mp_pack(rhod_mp *m, const rhod_particles *p, const rhod_cells *c) { pack_state(m, p, c); }
-
 void rhod_mp_rhs(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real dt) {
-  pack_state(m, p, c);
+  rhod_mp_pack(m, p, c);
   if (m->surface) {
     rhod_mp_pass_colour(m, p, c);
     const long nt = (long)(p->n + p->ng), st = (long)p->cap;

@@ -8,10 +8,9 @@
 
 #include "rhod/cells.h"
 #include "rhod/kernel_kind.h"
+#include "rhod/multiphase/scene.h" /* RHOD_MP_MAX_PHASES */
 #include "rhod/particles.h"
 #include "rhod/status.h"
-
-#define RHOD_MP_MAX_PHASES 8
 
 /* One fluid: Tait EOS (paper 000 Eq. 3) and dynamic viscosity; colour 1 liquid, 0 gas. */
 typedef struct {
