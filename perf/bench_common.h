@@ -24,6 +24,7 @@ static inline double bench_now(void) {
 
 typedef struct {
   rhod_scene sc;
+  rhod_rs_scene rs; /* sc.rs */
   rhod_fluid_block fb;
 } bench_scene;
 
@@ -34,23 +35,23 @@ typedef struct {
 static inline int bench_switches(rhod_scene *sc, int argc, char **argv, int first) {
   for (int k = first; k < argc; k++) {
     if (!strcmp(argv[k], "noshift"))
-      sc->shifting = 0;
+      sc->rs->shifting = 0;
     else if (!strcmp(argv[k], "nodamper"))
-      sc->acoustic_damper = 0;
+      sc->rs->acoustic_damper = 0;
     else if (!strcmp(argv[k], "nolimit"))
-      sc->damper_step_limit = 0;
+      sc->rs->damper_step_limit = 0;
     else if (!strcmp(argv[k], "nostiff"))
-      sc->stiffness_limit = 0;
+      sc->rs->stiffness_limit = 0;
     else if (!strcmp(argv[k], "nofs"))
-      sc->free_surface = 0;
+      sc->rs->free_surface = 0;
     else if (!strcmp(argv[k], "noriemann"))
-      sc->riemann = 0;
+      sc->rs->riemann = 0;
     else if (!strcmp(argv[k], "norecon"))
-      sc->reconstruction = 0;
+      sc->rs->reconstruction = 0;
     else if (!strcmp(argv[k], "visc"))
-      sc->mu = 10;
+      sc->rs->mu = 10;
     else if (!strcmp(argv[k], "visc_consistent"))
-      sc->mu = 10, sc->viscosity = RHOD_VISCOSITY_CONSISTENT;
+      sc->rs->mu = 10, sc->rs->viscosity = RHOD_VISCOSITY_CONSISTENT;
     else
       return -1;
   }
@@ -63,16 +64,17 @@ static inline int bench_setup(bench_scene *b, rhod_sim *s, double N, int patch, 
   const double L = 1.0, dx = L / side;
   rhod_scene *sc = &b->sc;
   memset(b, 0, sizeof *b);
-  sc->t_end = 1, sc->output_every = 1, sc->cfl = 0.5, sc->cfl_visc = 0.025;
+  sc->rs = &b->rs;
+  sc->t_end = 1, sc->output_every = 1, sc->rs->cfl = 0.5, sc->rs->cfl_visc = 0.025;
   sc->dx = dx, sc->radius_ratio = 4, sc->kernel = RHOD_KERNEL_WENDLAND_C2;
-  sc->levels = 1; /* single resolution (0 made dx_min = 2 dx and cells twice too big) */
-  sc->rho0 = 1000, sc->c0 = 10, sc->mu = 0;
-  sc->riemann = sc->reconstruction = sc->shifting = sc->acoustic_damper = 1;
-  sc->free_surface = 1;
-  sc->shift_a = 0.5, sc->shift_b = 0.05, sc->shift_eps = 5e-4, sc->alpha_ad = 1;
-  sc->damper_step_limit = 1, sc->stiffness_limit = 1;
-  sc->fs_lambda_low = 0.2, sc->fs_lambda_high = 0.75;
-  sc->shepard_threshold = 0.85, sc->theta_threshold = 0.95;
+  sc->rs->levels = 1; /* single resolution (0 made dx_min = 2 dx and cells twice too big) */
+  sc->rs->rho0 = 1000, sc->rs->c0 = 10, sc->rs->mu = 0;
+  sc->rs->riemann = sc->rs->reconstruction = sc->rs->shifting = sc->rs->acoustic_damper = 1;
+  sc->rs->free_surface = 1;
+  sc->rs->shift_a = 0.5, sc->rs->shift_b = 0.05, sc->rs->shift_eps = 5e-4, sc->rs->alpha_ad = 1;
+  sc->rs->damper_step_limit = 1, sc->rs->stiffness_limit = 1;
+  sc->rs->fs_lambda_low = 0.2, sc->rs->fs_lambda_high = 0.75;
+  sc->rs->shepard_threshold = 0.85, sc->rs->theta_threshold = 0.95;
   sc->has_domain = 1;
   sc->domain_min[0] = sc->domain_min[1] = patch ? -0.5 : 0;
   sc->domain_max[0] = sc->domain_max[1] = patch ? 1.5 : L;

@@ -56,7 +56,7 @@ int main(int argc, char **argv) {
     dmin = p->dx[i] < dmin ? p->dx[i] : dmin;
     dmax = p->dx[i] > dmax ? p->dx[i] : dmax;
     const int l =
-        (int)lround(log((double)sc->dx / p->dx[i]) / log(rhod_pattern_ratio(sc->pattern)));
+        (int)lround(log((double)sc->dx / p->dx[i]) / log(rhod_pattern_ratio(sc->rs->pattern)));
     if (l >= 0 && l < RHOD_MAX_LEVELS)
       per_level[l]++;
   }
@@ -65,7 +65,7 @@ int main(int argc, char **argv) {
   printf("%s: %zu particles (ghosts %zu), sizes %g .. %g, %s precision, %s\n", argv[1], p->n, p->ng,
          (double)dmin, (double)dmax, RHOD_REAL_NAME, where);
   printf("particles per level:");
-  for (int l = 0; l < sc->levels; l++)
+  for (int l = 0; l < sc->rs->levels; l++)
     printf(" %ld", per_level[l]);
   printf("\n%-34s %11s %11s %10s %10s %10s\n", "grid", "visited/p", "pairs/p", "pass A us",
          "pass C us", "A+C us");

@@ -2,6 +2,7 @@
 #define _GNU_SOURCE /* getopt_long, flock, realpath */
 #include "rhod/checkpoint.h"
 #include "rhod/io.h"
+#include "rhod/rhodsph/scene.h"
 #include "rhod/scene.h"
 #include "rhod/schedule.h"
 #include "rhod/sim.h"
@@ -732,10 +733,11 @@ static int run(run_opts *o, const char *resume_out) {
     logline("rhod: resumed from %s/checkpoint.rhod at t = %.9g s (step %ld)", out, s->t, s->step);
   logline("rhod: scene %s -> %s", c.sc->path, out);
   logline("rhod: kernels run on: %s", c.where);
-  if (c.sc->levels > 1)
+  const int levels = c.sc->rs ? c.sc->rs->levels : 1; /* refinement.levels (rhodsph) */
+  if (levels > 1)
     logline("rhod: %zu fluid particles, sizes %g m down to %g m (%d levels), R = %g dx, dt = %.4g "
             "s, %s precision",
-            s->p.n, c.sc->dx, s->dx_min, c.sc->levels, c.sc->radius_ratio, s->dt, RHOD_REAL_NAME);
+            s->p.n, c.sc->dx, s->dx_min, levels, c.sc->radius_ratio, s->dt, RHOD_REAL_NAME);
   else
     logline("rhod: %zu fluid particles, dx = %g m, R = %g m, dt = %.4g s, %s precision", s->p.n,
             c.sc->dx, c.sc->dx * c.sc->radius_ratio, s->dt, RHOD_REAL_NAME);
@@ -950,8 +952,9 @@ static int check_scene(run_opts *o) {
     per += sim.p.fields[k].elem;
   const double bytes = (double)per * (double)sim.p.cap;
   printf("scene: %s\n", sc->path);
-  printf("particles: %zu fluid (%d level%s, dx = %g m), %zu ghosts at t = 0\n", sim.p.n, sc->levels,
-         sc->levels > 1 ? "s" : "", sc->dx, sim.p.ng);
+  const int levels = sc->rs ? sc->rs->levels : 1; /* refinement.levels (rhodsph) */
+  printf("particles: %zu fluid (%d level%s, dx = %g m), %zu ghosts at t = 0\n", sim.p.n, levels,
+         levels > 1 ? "s" : "", sc->dx, sim.p.ng);
   printf("memory: %.1f MiB for the particle arrays (%zu bytes per particle, room for %zu)\n",
          bytes / 1048576.0, per, sim.p.cap);
   printf("first time step: %.4g s\n", sim.dt);

@@ -14,6 +14,7 @@
 #include "rhod/io.h"
 
 #include "multiphase/scene_mp.h"
+#include "rhodsph/scene_rs.h"
 #include "scene_module.h"
 #include "scene_yaml.h"
 
@@ -32,15 +33,6 @@
 #endif
 
 /* ---- the document as libcyaml loads it (optional values are pointers: NULL = absent) -- */
-
-typedef struct {
-  double min[2], max[2];
-} y_rect;
-
-typedef struct {
-  double center[2];
-  double radius;
-} y_circle;
 
 typedef struct {
   double U, L;
@@ -91,11 +83,11 @@ typedef struct {
   unsigned n_edges;
 } y_wall;
 
+/* rs: the rhodsph scheme's keys in the shared sections (src/rhodsph/scene_rs.h) */
 typedef struct {
   double end, output_every;
-  double *cfl, *cfl_visc;
   int *integrator;
-  bool *stiffness_limit;
+  y_rs_time rs;
 } y_time;
 
 typedef struct {
@@ -103,30 +95,17 @@ typedef struct {
   double *radius_ratio;
   int *kernel;
   double *jitter;
-  double *relax;
-  int *relax_where;
+  y_rs_particles rs;
 } y_particles;
 
 typedef struct {
-  double *rho0;
-  double *c0;
-  double *mu;
   double *gravity;
+  y_rs_physics rs;
 } y_physics;
 
 typedef struct {
   int *name;
-  bool *riemann, *reconstruction, *shifting;
-  double *shifting_a, *shifting_b, *shifting_eps;
-  bool *acoustic_damper;
-  double *alpha_ad;
-  bool *damper_step_limit;
-  bool *tensile_control;
-  int *shifting_switch;
-  bool *free_surface;
-  double *free_surface_lambda;
-  double *shepard_threshold, *theta_threshold;
-  int *viscosity;
+  y_rs_scheme rs;
 } y_scheme;
 
 typedef struct {
@@ -164,29 +143,6 @@ typedef struct {
 } y_probe;
 
 typedef struct {
-  y_rect *rect;
-  y_circle *circle;
-  double (*polygon)[2];
-  unsigned n_polygon;
-  double level;
-} y_region;
-
-typedef struct {
-  int quantity;
-  double *above, *below, *from;
-} y_refine_field;
-
-typedef struct {
-  double *levels;
-  y_region *regions;
-  unsigned n_regions;
-  bool *dynamic, *free_surface, *walls, *coalesce;
-  double *surface_band, *crowding;
-  int *pattern;
-  y_refine_field *field;
-} y_refinement;
-
-typedef struct {
   double *every;
   y_probe *list;
   unsigned n_list;
@@ -217,8 +173,8 @@ typedef struct {
   unsigned n_walls;
   y_probes *probes;
   y_output *output;
-  y_refinement *refinement;
-  y_mp_phase *phases; /* the multiphase scheme's sections (src/multiphase/scene_mp.c) */
+  y_rs_refinement *refinement; /* the rhodsph scheme's section (src/rhodsph/scene_rs.c) */
+  y_mp_phase *phases;          /* the multiphase scheme's sections (src/multiphase/scene_mp.c) */
   unsigned n_phases;
   y_mp_section *multiphase;
 } y_doc;
@@ -228,13 +184,13 @@ typedef struct {
 #define OPT (CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL)
 #define NAME_MAX_LEN 64
 
-static const cyaml_schema_value_t sch_float = {CYAML_VALUE_FLOAT(CYAML_FLAG_STRICT, double)};
+const cyaml_schema_value_t rhod_sl_sch_float = {CYAML_VALUE_FLOAT(CYAML_FLAG_STRICT, double)};
 static const cyaml_schema_value_t sch_bool = {CYAML_VALUE_BOOL(CYAML_FLAG_DEFAULT, bool)};
-static const cyaml_schema_value_t sch_vec = {
-    CYAML_VALUE_SEQUENCE_FIXED(CYAML_FLAG_FLOW, double, &sch_float, 2)};
+const cyaml_schema_value_t rhod_sl_sch_vec = {
+    CYAML_VALUE_SEQUENCE_FIXED(CYAML_FLAG_FLOW, double, &rhod_sl_sch_float, 2)};
 
 #define VEC(key, flags, st, member)                                                                \
-  CYAML_FIELD_SEQUENCE_FIXED(key, (flags) | CYAML_FLAG_FLOW, st, member, &sch_float, 2)
+  CYAML_FIELD_SEQUENCE_FIXED(key, (flags) | CYAML_FLAG_FLOW, st, member, &rhod_sl_sch_float, 2)
 #define NUM(key, st, member) CYAML_FIELD_FLOAT(key, CYAML_FLAG_STRICT, st, member)
 #define NUM_OPT(key, st, member) CYAML_FIELD_FLOAT_PTR(key, OPT | CYAML_FLAG_STRICT, st, member)
 #define BOOL_OPT(key, st, member) CYAML_FIELD_BOOL_PTR(key, OPT, st, member)
@@ -269,42 +225,20 @@ static const cyaml_strval_t field_names[] = {
     {"density", RHOD_FIELD_DENSITY},           {"size", RHOD_FIELD_SIZE},
     {"free_surface", RHOD_FIELD_FREE_SURFACE}, {"phase", RHOD_FIELD_PHASE},
 };
-static const cyaml_strval_t quantity_names[] = {
-    {"pressure", RHOD_QTY_PRESSURE},
-    {"dynamic_pressure", RHOD_QTY_DYNAMIC_PRESSURE},
-};
-static const cyaml_strval_t viscosity_names[] = {
-    {"monaghan", RHOD_VISCOSITY_MONAGHAN},
-    {"consistent", RHOD_VISCOSITY_CONSISTENT},
-};
-static const cyaml_strval_t shifting_switch_names[] = {
-    {"false", RHOD_SHSW_NONE},
-    {"momentum", RHOD_SHSW_MOMENTUM},
-    {"true", RHOD_SHSW_ALL},
-    {"balanced", RHOD_SHSW_BALANCED},
-    {"balanced_momentum", RHOD_SHSW_BALANCED_MOMENTUM},
-};
-static const cyaml_strval_t relax_where_names[] = {
-    {"all", RHOD_RELAX_ALL},
-    {"jumps", RHOD_RELAX_JUMPS},
-};
-static const cyaml_strval_t pattern_names[] = {
-    {"square", RHOD_PATTERN_SQUARE},
-    {"triangle", RHOD_PATTERN_TRIANGLE},
-};
 static const char *const probe_kind_names[] = {
     "pressure", "kinetic_energy",   "potential_energy", "front",         "mass",
     "momentum", "angular_momentum", "elastic_energy",   "torque_budget",
 };
 #define N_PROBE_KINDS 9
 
+/* Each section's keys in the order they always had; RHOD_RS_*_FIELDS are the rhodsph
+ * scheme's (src/rhodsph/scene_rs.h). */
 static const cyaml_schema_field_t f_time[] = {
     NUM("end", y_time, end),
     NUM("output_every", y_time, output_every),
-    NUM_OPT("cfl", y_time, cfl),
-    NUM_OPT("cfl_visc", y_time, cfl_visc),
+    RHOD_RS_TIME_STEP_FIELDS(y_time, rs),
     ENUM_OPT("integrator", y_time, integrator, integrator_names),
-    BOOL_OPT("stiffness_limit", y_time, stiffness_limit),
+    RHOD_RS_TIME_LIMIT_FIELDS(y_time, rs),
     CYAML_FIELD_END,
 };
 
@@ -312,39 +246,21 @@ static const cyaml_schema_field_t f_particles[] = {
     NUM("dx", y_particles, dx),
     NUM_OPT("radius_ratio", y_particles, radius_ratio),
     NUM_OPT("jitter", y_particles, jitter),
-    NUM_OPT("relax", y_particles, relax),
-    ENUM_OPT("relax_where", y_particles, relax_where, relax_where_names),
+    RHOD_RS_PARTICLES_FIELDS(y_particles, rs),
     ENUM_OPT("kernel", y_particles, kernel, kernel_names),
     CYAML_FIELD_END,
 };
 
-/* physics.c0 is required for rhodsph only (convert) */
+/* physics and its c0 are required for rhodsph only (rhod_rs_load_physics) */
 static const cyaml_schema_field_t f_physics[] = {
-    NUM_OPT("rho0", y_physics, rho0),
-    NUM_OPT("c0", y_physics, c0),
-    NUM_OPT("mu", y_physics, mu),
+    RHOD_RS_PHYSICS_FIELDS(y_physics, rs),
     VEC("gravity", OPT, y_physics, gravity),
     CYAML_FIELD_END,
 };
 
 static const cyaml_schema_field_t f_scheme[] = {
     ENUM_OPT("name", y_scheme, name, scheme_names),
-    BOOL_OPT("riemann", y_scheme, riemann),
-    BOOL_OPT("reconstruction", y_scheme, reconstruction),
-    BOOL_OPT("shifting", y_scheme, shifting),
-    NUM_OPT("shifting_a", y_scheme, shifting_a),
-    NUM_OPT("shifting_b", y_scheme, shifting_b),
-    NUM_OPT("shifting_eps", y_scheme, shifting_eps),
-    BOOL_OPT("acoustic_damper", y_scheme, acoustic_damper),
-    NUM_OPT("alpha_ad", y_scheme, alpha_ad),
-    BOOL_OPT("damper_step_limit", y_scheme, damper_step_limit),
-    BOOL_OPT("tensile_control", y_scheme, tensile_control),
-    ENUM_OPT("shifting_switch", y_scheme, shifting_switch, shifting_switch_names),
-    BOOL_OPT("free_surface", y_scheme, free_surface),
-    VEC("free_surface_lambda", OPT, y_scheme, free_surface_lambda),
-    NUM_OPT("shepard_threshold", y_scheme, shepard_threshold),
-    NUM_OPT("theta_threshold", y_scheme, theta_threshold),
-    ENUM_OPT("viscosity", y_scheme, viscosity, viscosity_names),
+    RHOD_RS_SCHEME_FIELDS(y_scheme, rs),
     CYAML_FIELD_END,
 };
 
@@ -355,23 +271,17 @@ static const cyaml_schema_field_t f_domain[] = {
     CYAML_FIELD_END,
 };
 
-static const cyaml_schema_field_t f_rect[] = {
+const cyaml_schema_field_t rhod_sl_f_rect[] = {
     VEC("min", 0, y_rect, min),
     VEC("max", 0, y_rect, max),
     CYAML_FIELD_END,
 };
 
-static const cyaml_schema_field_t f_circle[] = {
+const cyaml_schema_field_t rhod_sl_f_circle[] = {
     VEC("center", 0, y_circle, center),
     NUM("radius", y_circle, radius),
     CYAML_FIELD_END,
 };
-
-#define SHAPE_FIELDS(st)                                                                           \
-  CYAML_FIELD_MAPPING_PTR("rect", OPT | CYAML_FLAG_FLOW, st, rect, f_rect),                        \
-      CYAML_FIELD_MAPPING_PTR("circle", OPT | CYAML_FLAG_FLOW, st, circle, f_circle),              \
-      CYAML_FIELD_SEQUENCE_COUNT("polygon", OPT | CYAML_FLAG_FLOW, st, polygon, n_polygon,         \
-                                 &sch_vec, 3, CYAML_UNLIMITED)
 
 static const cyaml_schema_field_t f_taylor_green[] = {
     NUM("U", y_taylor_green, U),
@@ -414,7 +324,7 @@ static const cyaml_schema_field_t f_initial[] = {
 };
 
 static const cyaml_schema_field_t f_fluid[] = {
-    SHAPE_FIELDS(y_fluid),
+    RHOD_SL_SHAPE_FIELDS(y_fluid),
     VEC("velocity", OPT, y_fluid, velocity),
     ENUM_OPT("pressure", y_fluid, pressure, init_names),
     NUM_OPT("surface", y_fluid, surface),
@@ -426,12 +336,12 @@ static const cyaml_schema_value_t sch_fluid = {
     CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, y_fluid, f_fluid)};
 
 static const cyaml_schema_field_t f_wall[] = {
-    SHAPE_FIELDS(y_wall),
+    RHOD_SL_SHAPE_FIELDS(y_wall),
     ENUM_OPT("slip", y_wall, slip, slip_names),
     BOOL_OPT("fluid_inside", y_wall, fluid_inside),
     VEC("velocity", OPT, y_wall, velocity),
-    CYAML_FIELD_SEQUENCE_COUNT("edges", OPT | CYAML_FLAG_FLOW, y_wall, edges, n_edges, &sch_float,
-                               1, CYAML_UNLIMITED),
+    CYAML_FIELD_SEQUENCE_COUNT("edges", OPT | CYAML_FLAG_FLOW, y_wall, edges, n_edges,
+                               &rhod_sl_sch_float, 1, CYAML_UNLIMITED),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_wall = {
@@ -484,40 +394,8 @@ static const cyaml_schema_field_t f_picture[] = {
     ENUM_OPT("field", y_picture, field, field_names),
     NUM_OPT("width", y_picture, width),
     VEC("range", OPT, y_picture, range),
-    CYAML_FIELD_MAPPING_PTR("box", OPT | CYAML_FLAG_FLOW, y_picture, box, f_rect),
+    CYAML_FIELD_MAPPING_PTR("box", OPT | CYAML_FLAG_FLOW, y_picture, box, rhod_sl_f_rect),
     BOOL_OPT("size_panel", y_picture, size_panel),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t f_region[] = {
-    SHAPE_FIELDS(y_region),
-    NUM("level", y_region, level),
-    CYAML_FIELD_END,
-};
-static const cyaml_schema_value_t sch_region = {
-    CYAML_VALUE_MAPPING(CYAML_FLAG_DEFAULT, y_region, f_region)};
-
-static const cyaml_schema_field_t f_refine_field[] = {
-    CYAML_FIELD_ENUM("quantity", CYAML_FLAG_STRICT, y_refine_field, quantity, quantity_names,
-                     CYAML_ARRAY_LEN(quantity_names)),
-    NUM_OPT("above", y_refine_field, above),
-    NUM_OPT("below", y_refine_field, below),
-    NUM_OPT("from", y_refine_field, from),
-    CYAML_FIELD_END,
-};
-
-static const cyaml_schema_field_t f_refinement[] = {
-    NUM_OPT("levels", y_refinement, levels),
-    ENUM_OPT("pattern", y_refinement, pattern, pattern_names),
-    CYAML_FIELD_SEQUENCE_COUNT("regions", OPT, y_refinement, regions, n_regions, &sch_region, 0,
-                               CYAML_UNLIMITED),
-    BOOL_OPT("dynamic", y_refinement, dynamic),
-    BOOL_OPT("free_surface", y_refinement, free_surface),
-    NUM_OPT("surface_band", y_refinement, surface_band),
-    NUM_OPT("crowding", y_refinement, crowding),
-    BOOL_OPT("walls", y_refinement, walls),
-    BOOL_OPT("coalesce", y_refinement, coalesce),
-    CYAML_FIELD_MAPPING_PTR("field", OPT | CYAML_FLAG_FLOW, y_refinement, field, f_refine_field),
     CYAML_FIELD_END,
 };
 
@@ -539,7 +417,7 @@ static const cyaml_schema_field_t f_doc[] = {
     CYAML_FIELD_SEQUENCE_COUNT("walls", OPT, y_doc, walls, n_walls, &sch_wall, 0, CYAML_UNLIMITED),
     CYAML_FIELD_MAPPING_PTR("probes", OPT, y_doc, probes, f_probes),
     CYAML_FIELD_MAPPING_PTR("output", OPT, y_doc, output, f_output),
-    CYAML_FIELD_MAPPING_PTR("refinement", OPT, y_doc, refinement, f_refinement),
+    CYAML_FIELD_MAPPING_PTR("refinement", OPT, y_doc, refinement, rhod_rs_f_refinement),
     CYAML_FIELD_SEQUENCE_COUNT("phases", OPT, y_doc, phases, n_phases, &rhod_mp_sch_phase, 1,
                                RHOD_MP_MAX_PHASES),
     CYAML_FIELD_MAPPING_PTR("multiphase", OPT, y_doc, multiphase, rhod_mp_f_section),
@@ -689,6 +567,10 @@ int rhod_sl_fail_missing(lctx *c, const char *path, const char *key, const char 
 }
 
 int rhod_sl_fail_oom(lctx *c) { return fail_oom(c); }
+
+int rhod_sl_given(lctx *c, const char *section) {
+  return c->root->kind == RY_MAP && ry_map_get(c->root, section);
+}
 
 int rhod_sl_identifier(const char *s) {
   static const char alpha[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ_";
@@ -1182,8 +1064,6 @@ static int check_range(lctx *c, const char *path, double v, double lo, int lo_op
               hi_open ? ")" : "]", v);
 }
 
-static int opt_bool(const bool *p, int def) { return p ? (*p ? 1 : 0) : def; }
-
 static double polygon_area(const double (*p)[2], unsigned n) {
   double a = 0;
   for (unsigned i = 0; i < n; i++) {
@@ -1210,7 +1090,7 @@ static int segments_meet(const double *a, const double *b, const double *p, cons
          (d3 == 0 && on_segment(a, b, p)) || (d4 == 0 && on_segment(a, b, q));
 }
 
-static void shape_bbox(const rhod_shape *sh, double lo[2], double hi[2]) {
+void rhod_sl_shape_bbox(const rhod_shape *sh, double lo[2], double hi[2]) {
   for (int d = 0; d < 2; d++) {
     switch (sh->kind) {
     case RHOD_SHAPE_RECT:
@@ -1232,7 +1112,7 @@ static void shape_bbox(const rhod_shape *sh, double lo[2], double hi[2]) {
   }
 }
 
-static double shape_area(const rhod_shape *sh) {
+double rhod_sl_shape_area(const rhod_shape *sh) {
   switch (sh->kind) {
   case RHOD_SHAPE_RECT:
     return (sh->max[0] - sh->min[0]) * (sh->max[1] - sh->min[1]);
@@ -1245,8 +1125,8 @@ static double shape_area(const rhod_shape *sh) {
 }
 
 /* One of rect / circle / polygon, checked and copied into out (polygons counter-clockwise). */
-static int load_shape(lctx *c, const char *base, const y_rect *rect, const y_circle *circle,
-                      double (*poly)[2], unsigned np, rhod_shape *out) {
+int rhod_sl_load_shape(lctx *c, const char *base, const y_rect *rect, const y_circle *circle,
+                       double (*poly)[2], unsigned np, rhod_shape *out) {
   char path[128];
   const char *given[3];
   int n = 0;
@@ -1475,86 +1355,6 @@ static unsigned probe_columns(const rhod_probe *p,
   return nc;
 }
 
-/* refinement: levels, initial regions and the switchable criteria of Sec. V B. */
-static int load_refinement(lctx *c, const y_refinement *r, rhod_scene *s) {
-  char path[128];
-  const double levels = r && r->levels ? *r->levels : 1;
-  if (!(levels >= 1 && levels <= RHOD_MAX_LEVELS && levels == floor(levels)))
-    return fail(c, "refinement.levels", "must be a whole number in [1, %d], got %g",
-                RHOD_MAX_LEVELS, levels);
-  s->levels = (int)levels;
-  s->pattern = r && r->pattern ? (rhod_pattern)*r->pattern : RHOD_PATTERN_SQUARE;
-  s->refine_dynamic = s->levels > 1 && opt_bool(r ? r->dynamic : NULL, 1);
-  s->refine_free_surface = opt_bool(r ? r->free_surface : NULL, 0);
-  /* criterion 3's reach, no lower than 1/e (e the size ratio of adjacent levels): a
-   * free-surface particle's support then holds only the finest size */
-  s->refine_band = opt(r ? r->surface_band : NULL, 1);
-  const double band_min = 1 / rhod_pattern_ratio(s->pattern);
-  if (!(s->refine_band >= band_min * (1 - 1e-12) && s->refine_band <= 1))
-    return fail(c, "refinement.surface_band",
-                "must be in [%.4g, 1] (a fraction of the particle's support radius, at least "
-                "1 over the size ratio of adjacent levels), got %g",
-                band_min, s->refine_band);
-  if (r && r->surface_band && !s->refine_free_surface)
-    return fail(c, "refinement.surface_band", "needs criterion 3 (refinement.free_surface: true)");
-  /* our criterion against a finer particle inside a coarser one's share of the plane
-   * (docs/choices.md "crowding at size jumps"): a fraction of the mean of the two sizes */
-  s->refine_crowding = opt(r ? r->crowding : NULL, RHOD_CROWDING_DEFAULT);
-  if (!(s->refine_crowding >= 0 && s->refine_crowding < 1))
-    return fail(c, "refinement.crowding",
-                "must be in [0, 1) (a fraction of the mean of the two particles' sizes; 0: "
-                "off), got %g",
-                s->refine_crowding);
-  s->refine_walls = opt_bool(r ? r->walls : NULL, 0);
-  s->refine_coalesce = opt_bool(r ? r->coalesce : NULL, 0);
-  if (r && r->n_regions && s->pattern != RHOD_PATTERN_SQUARE)
-    return fail(c, "refinement.regions",
-                "need refinement.pattern: square (initial levels are nested lattices, "
-                "halved in each region); with triangle the criteria refine at t = 0");
-  if (r && r->n_regions) {
-    s->regions = calloc(r->n_regions, sizeof *s->regions);
-    if (!s->regions)
-      return fail_oom(c);
-    s->n_regions = r->n_regions;
-  }
-  for (unsigned i = 0; i < s->n_regions; i++) {
-    const y_region *y = &r->regions[i];
-    snprintf(path, sizeof path, "refinement.regions.%u", i);
-    TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &s->regions[i].shape));
-    snprintf(path, sizeof path, "refinement.regions.%u.level", i);
-    if (!(y->level >= 1 && y->level <= s->levels - 1 && y->level == floor(y->level)))
-      return fail(c, path,
-                  "must be a whole number in [1, refinement.levels - 1 = %d] (level 0 is "
-                  "particles.dx), got %g",
-                  s->levels - 1, y->level);
-    s->regions[i].level = (int)y->level;
-  }
-  const y_refine_field *f = r ? r->field : NULL;
-  if (f) {
-    if (!f->above && !f->below)
-      return fail(c, "refinement.field", "needs a threshold: above, below or both");
-    s->refine_field = 1;
-    s->field_quantity = (rhod_quantity)f->quantity;
-    s->field_above = f->above ? *f->above : HUGE_VAL;
-    s->field_below = f->below ? *f->below : -HUGE_VAL;
-    s->field_from = opt(f->from, 0);
-    if (f->above && f->below && !(s->field_below < s->field_above))
-      return fail(c, "refinement.field.below", "(%g) must be below refinement.field.above (%g)",
-                  s->field_below, s->field_above);
-  }
-  if (s->refine_free_surface && !s->free_surface)
-    return fail(c, "refinement.free_surface",
-                "criterion 3 needs the free-surface detection (scheme.free_surface: true)");
-  if (s->refine_coalesce && !s->refine_dynamic)
-    return fail(c, "refinement.coalesce",
-                "needs dynamic refinement (refinement.dynamic: true and levels >= 2)");
-  const int any = s->refine_free_surface || s->refine_walls || s->refine_field;
-  if (s->levels == 1 && (any || s->n_regions))
-    return fail(c, "refinement.levels",
-                "is 1 (single resolution): regions and criteria need at least 2 levels");
-  return RHOD_OK;
-}
-
 /* Extent of one shape along the unit vector e: [lo, hi] of x.e. */
 static void shape_extent(const rhod_shape *sh, const double e[2], double *lo, double *hi) {
   *lo = INFINITY;
@@ -1584,31 +1384,17 @@ static void shape_extent(const rhod_shape *sh, const double e[2], double *lo, do
   }
 }
 
-/* Area of the overlap of two boxes. */
-static double box_overlap(const double alo[2], const double ahi[2], const double blo[2],
-                          const double bhi[2]) {
-  double a = 1;
-  for (int d = 0; d < 2; d++)
-    a *= fmax(0, fmin(ahi[d], bhi[d]) - fmax(alo[d], blo[d]));
-  return a;
-}
-
 double rhod_scene_particle_estimate(const rhod_scene *s) {
   if (!s || !(s->dx > 0))
     return 0;
   const double cell = s->dx * s->dx;
   double n = 0;
   for (unsigned i = 0; i < s->n_fluid; i++) {
-    n += shape_area(&s->fluid[i].shape) / cell;
-    /* a region at level l puts 4^l particles in each coarse cell it covers */
+    n += rhod_sl_shape_area(&s->fluid[i].shape) / cell;
+    /* the rhodsph scheme's refinement regions: their finer lattices */
     double lo[2], hi[2];
-    shape_bbox(&s->fluid[i].shape, lo, hi);
-    for (unsigned r = 0; r < s->n_regions; r++) {
-      double rlo[2], rhi[2];
-      shape_bbox(&s->regions[r].shape, rlo, rhi);
-      const double area = fmin(box_overlap(lo, hi, rlo, rhi), shape_area(&s->regions[r].shape));
-      n += area / cell * (ldexp(1, 2 * s->regions[r].level) - 1);
-    }
+    rhod_sl_shape_bbox(&s->fluid[i].shape, lo, hi);
+    rhod_rs_region_estimate(s->rs, lo, hi, cell, &n);
   }
   return n;
 }
@@ -1635,7 +1421,7 @@ static int check_limits(lctx *c, rhod_scene *s) {
   }
   /* time: every step is at most the acoustic bound at the coarsest size: Eq. 11 of paper
    * 002 for rhodsph, paper 001 Eq. 16 (h_s < R) with the fastest phase for multiphase */
-  double c_max = s->c0, cfl = s->cfl;
+  double c_max = s->rs ? s->rs->c0 : 0, cfl = s->rs ? s->rs->cfl : 0;
   if (s->mp) {
     cfl = s->mp->cfl;
     c_max = 0;
@@ -1672,30 +1458,12 @@ static int check_limits(lctx *c, rhod_scene *s) {
     return fail(c, "particles.dx",
                 "%g m makes about %.3g particles (the fluid's area over dx^2%s), more than the "
                 "%.0e a run can index",
-                s->dx, n, s->n_regions ? " and the refinement regions" : "", RHOD_MAX_PARTICLES);
+                s->dx, n, s->rs && s->rs->n_regions ? " and the refinement regions" : "",
+                RHOD_MAX_PARTICLES);
   return RHOD_OK;
 }
 
 /* ---- the two schemes' keys ------------------------------------------------------------- */
-
-/* Keys of the rhodsph scheme (paper 002) that a multiphase scene refuses: the scheme's
- * switches, refinement (APR), its single fluid's state law and viscosity, the initial
- * relaxation, and its time step (Eq. 11 and the RK4 stiffness limit; the multiphase
- * scheme has multiphase.cfl*). */
-static int rhod_only(const char *section, const char *key) {
-  if (strcmp(section, "scheme") == 0)
-    return strcmp(key, "name") != 0;
-  if (strcmp(section, "refinement") == 0)
-    return 1;
-  if (strcmp(section, "physics") == 0)
-    return strcmp(key, "rho0") == 0 || strcmp(key, "c0") == 0 || strcmp(key, "mu") == 0;
-  if (strcmp(section, "particles") == 0)
-    return strncmp(key, "relax", 5) == 0;
-  if (strcmp(section, "time") == 0)
-    return strcmp(key, "stiffness_limit") == 0 || strcmp(key, "cfl") == 0 ||
-           strcmp(key, "cfl_visc") == 0;
-  return 0;
-}
 
 /* Where a key's error points: the key in the file, or the override that set its value. */
 static const ry_node *key_at(const ry_node *map, unsigned j) {
@@ -1728,7 +1496,7 @@ static int refuse_other_scheme(lctx *c, rhod_scheme_kind scheme) {
       return fail_at(c, key_at(r, i), sec,
                      "belongs to the rhodsph scheme, not to scheme.name: multiphase");
     for (unsigned j = 0; m->kind == RY_MAP && j < m->n; j++)
-      if (rhod_only(sec, m->keys[j]->text)) {
+      if (rhod_rs_owns(sec, m->keys[j]->text)) {
         snprintf(path, sizeof path, "%s.%s", sec, m->keys[j]->text);
         return fail_at(c, key_at(m, j), path,
                        "belongs to the rhodsph scheme, not to scheme.name: multiphase");
@@ -1850,16 +1618,15 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   /* time */
   s->t_end = d->time.end;
   s->output_every = d->time.output_every;
-  s->cfl = opt(d->time.cfl, 0.5);
-  s->cfl_visc = opt(d->time.cfl_visc, 0.025);
   s->integrator = d->time.integrator ? (rhod_integrator_kind)*d->time.integrator
                   : mpx              ? RHOD_INTEGRATOR_MIDPOINT
                                      : RHOD_INTEGRATOR_RK4;
-  s->stiffness_limit = !mpx && opt_bool(d->time.stiffness_limit, 1);
   TRY(check_positive(c, "time.end", s->t_end));
   TRY(check_positive(c, "time.output_every", s->output_every));
-  TRY(check_range(c, "time.cfl", s->cfl, 0, 1, 1, 0));
-  TRY(check_positive(c, "time.cfl_visc", s->cfl_visc));
+  /* the rhodsph scheme's keys, section by section where they were always checked (a
+   * multiphase scene has none of them: refuse_other_scheme) */
+  if (!mpx)
+    TRY(rhod_rs_load_time(c, &d->time.rs, s));
   /* particles */
   s->dx = d->particles.dx;
   s->radius_ratio = opt(d->particles.radius_ratio, 4);
@@ -1870,70 +1637,16 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   TRY(check_range(c, "particles.radius_ratio", s->radius_ratio, 2, 0, 8, 0));
   s->jitter = opt(d->particles.jitter, 0);
   TRY(check_range(c, "particles.jitter", s->jitter, 0, 0, 0.5, 0));
-  const double relax = opt(d->particles.relax, 0);
-  if (!(relax >= 0 && relax <= RHOD_RELAX_MAX && relax == floor(relax)))
-    return fail(c, "particles.relax", "must be a whole number in [0, %d], got %g", RHOD_RELAX_MAX,
-                relax);
-  s->relax = (int)relax;
-  s->relax_where =
-      d->particles.relax_where ? (rhod_relax_where)*d->particles.relax_where : RHOD_RELAX_ALL;
-  if (d->particles.relax_where && s->relax == 0)
-    return fail(c, "particles.relax_where", "needs particles.relax (iterations) above 0");
+  if (!mpx)
+    TRY(rhod_rs_load_particles(c, &d->particles.rs, s));
   /* physics: rho0, c0, mu are rhodsph's (the multiphase scheme's are its phases') */
   if (d->physics.gravity)
     memcpy(s->gravity, d->physics.gravity, sizeof s->gravity);
-  if (!mpx) {
-    if (!(c->root->kind == RY_MAP && ry_map_get(c->root, "physics")))
-      return fail_missing(c, "", "physics", NULL);
-    if (!d->physics.c0)
-      return fail_missing(c, "physics", "c0", NULL);
-    s->rho0 = opt(d->physics.rho0, 1000);
-    s->c0 = *d->physics.c0;
-    s->mu = opt(d->physics.mu, 0);
-    TRY(check_positive(c, "physics.rho0", s->rho0));
-    TRY(check_positive(c, "physics.c0", s->c0));
-    if (!(s->mu >= 0))
-      return fail(c, "physics.mu", "must be >= 0, got %g", s->mu);
-  }
+  if (!mpx)
+    TRY(rhod_rs_load_physics(c, &d->physics.rs, s));
   /* scheme */
-  const y_scheme *sc = d->scheme;
-  static const y_scheme none = {0};
-  if (!sc)
-    sc = &none;
-  s->riemann = opt_bool(sc->riemann, 1);
-  s->reconstruction = opt_bool(sc->reconstruction, 1);
-  s->shifting = opt_bool(sc->shifting, 1);
-  s->shift_a = opt(sc->shifting_a, 0.5);
-  s->shift_b = opt(sc->shifting_b, 0.05);
-  s->shift_eps = opt(sc->shifting_eps, 5e-4);
-  s->acoustic_damper = opt_bool(sc->acoustic_damper, 1);
-  s->alpha_ad = opt(sc->alpha_ad, 1);
-  s->damper_step_limit = opt_bool(sc->damper_step_limit, 1);
-  s->tensile_control = opt_bool(sc->tensile_control, 0);
-  s->shifting_switch =
-      sc->shifting_switch ? (rhod_shifting_switch)*sc->shifting_switch : RHOD_SHSW_NONE;
-  s->free_surface = opt_bool(sc->free_surface, 1);
-  s->fs_lambda_low = sc->free_surface_lambda ? sc->free_surface_lambda[0] : 0.2;
-  s->fs_lambda_high = sc->free_surface_lambda ? sc->free_surface_lambda[1] : 0.75;
-  s->shepard_threshold = opt(sc->shepard_threshold, 0.85);
-  s->theta_threshold = opt(sc->theta_threshold, 0.95);
-  s->viscosity = sc->viscosity ? (rhod_viscosity)*sc->viscosity : RHOD_VISCOSITY_MONAGHAN;
-  TRY(check_positive(c, "scheme.shifting_a", s->shift_a));
-  if (!(s->shift_b >= 0))
-    return fail(c, "scheme.shifting_b", "must be >= 0, got %g", s->shift_b);
-  TRY(check_positive(c, "scheme.shifting_eps", s->shift_eps));
-  TRY(check_positive(c, "scheme.alpha_ad", s->alpha_ad));
-  for (int i = 0; i < 2; i++) {
-    double v = i ? s->fs_lambda_high : s->fs_lambda_low;
-    if (!(v > 0 && v < 1.5))
-      return fail(c, "scheme.free_surface_lambda", "%s threshold must be in (0, 1.5), got %g",
-                  i ? "high" : "low", v);
-  }
-  if (!(s->fs_lambda_low < s->fs_lambda_high))
-    return fail(c, "scheme.free_surface_lambda", "low (%g) must be below high (%g)",
-                s->fs_lambda_low, s->fs_lambda_high);
-  TRY(check_range(c, "scheme.shepard_threshold", s->shepard_threshold, 0, 1, 1, 0));
-  TRY(check_range(c, "scheme.theta_threshold", s->theta_threshold, 0, 1, 1, 0));
+  if (!mpx)
+    TRY(rhod_rs_load_scheme(c, d->scheme ? &d->scheme->rs : NULL, s));
   /* domain */
   const y_domain *dm = d->domain;
   if (dm && (!dm->min) != (!dm->max))
@@ -1961,7 +1674,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     const y_fluid *y = &d->fluid[i];
     rhod_fluid_block *b = &s->fluid[i];
     snprintf(path, sizeof path, "fluid.%u", i);
-    TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &b->shape));
+    TRY(rhod_sl_load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &b->shape));
     if (y->velocity)
       memcpy(b->velocity, y->velocity, sizeof b->velocity);
     b->pressure = y->pressure ? (rhod_init_kind)*y->pressure : RHOD_INIT_HYDROSTATIC;
@@ -1985,7 +1698,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       b->surface = *y->surface;
     }
     double lo[2], hi[2];
-    shape_bbox(&b->shape, lo, hi);
+    rhod_sl_shape_bbox(&b->shape, lo, hi);
     if (y->initial) {
       const y_initial *in = y->initial;
       char ip[192];
@@ -2043,7 +1756,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
                   "lies outside the domain [%g, %g]-[%g, %g] (block spans [%g, %g]-[%g, %g])",
                   s->domain_min[0], s->domain_min[1], s->domain_max[0], s->domain_max[1], lo[0],
                   lo[1], hi[0], hi[1]);
-    double area = shape_area(&b->shape), w = fmin(hi[0] - lo[0], hi[1] - lo[1]);
+    double area = rhod_sl_shape_area(&b->shape), w = fmin(hi[0] - lo[0], hi[1] - lo[1]);
     if (area < s->dx * s->dx * (1 - 1e-9) || w < s->dx * (1 - 1e-9))
       return fail(c, "particles.dx",
                   "%g m is too coarse for fluid.%u (%g m wide, area %g m^2): a block must hold "
@@ -2061,19 +1774,20 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     const y_wall *y = &d->walls[i];
     rhod_wall *w = &s->walls[i];
     snprintf(path, sizeof path, "walls.%u", i);
-    TRY(load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &w->shape));
+    TRY(rhod_sl_load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &w->shape));
     w->slip = y->slip ? (rhod_slip)*y->slip : RHOD_SLIP_FREE;
     w->fluid_inside = opt_bool(y->fluid_inside, 1);
     TRY(load_wall_motion(c, y, i, w, s->periodic));
   }
   /* refinement (paper 002 Sec. V) */
-  TRY(load_refinement(c, d->refinement, s));
+  if (!mpx)
+    TRY(rhod_rs_load_refinement(c, d->refinement, s));
   /* the default domain: bounding box of walls and fluid */
   if (!s->has_domain) {
     for (unsigned i = 0; i < s->n_fluid + s->n_walls; i++) {
       const rhod_shape *sh = i < s->n_fluid ? &s->fluid[i].shape : &s->walls[i - s->n_fluid].shape;
       double lo[2], hi[2];
-      shape_bbox(sh, lo, hi);
+      rhod_sl_shape_bbox(sh, lo, hi);
       for (int a = 0; a < 2; a++) {
         s->domain_min[a] = i ? fmin(s->domain_min[a], lo[a]) : lo[a];
         s->domain_max[a] = i ? fmax(s->domain_max[a], hi[a]) : hi[a];
@@ -2134,8 +1848,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
                 width);
   s->picture_width = (unsigned)width;
   /* with refinement, the sizes beside the field unless the field is the size */
-  s->picture_size_panel =
-      opt_bool(pic ? pic->size_panel : NULL, s->levels > 1) && s->picture_field != RHOD_FIELD_SIZE;
+  s->picture_size_panel = opt_bool(pic ? pic->size_panel : NULL, s->rs && s->rs->levels > 1) &&
+                          s->picture_field != RHOD_FIELD_SIZE;
   if (pic && pic->range) {
     s->picture_range_set = 1;
     s->picture_range[0] = pic->range[0];
@@ -2270,7 +1984,11 @@ void rhod_sl_word(rhod_sl_tb *t, ry_node *parent, const char *key, const char *v
   tb_word(t, parent, key, v);
 }
 
-static void tb_shape(tb *t, ry_node *entry, const rhod_shape *sh) {
+void rhod_sl_vec(rhod_sl_tb *t, ry_node *parent, const char *key, const double v[2]) {
+  tb_vec(t, parent, key, v);
+}
+
+void rhod_sl_shape(rhod_sl_tb *t, ry_node *entry, const rhod_shape *sh) {
   ry_node *m;
   switch (sh->kind) {
   case RHOD_SHAPE_RECT:
@@ -2291,7 +2009,7 @@ static void tb_shape(tb *t, ry_node *entry, const rhod_shape *sh) {
   }
 }
 
-static const char *strval_name(const cyaml_strval_t *sv, size_t n, int v) {
+const char *rhod_sl_enum_name(const cyaml_strval_t *sv, size_t n, int v) {
   for (size_t i = 0; i < n; i++)
     if (sv[i].val == v)
       return sv[i].str;
@@ -2303,67 +2021,42 @@ static ry_node *scene_tree(const rhod_scene *s) {
   ry_node *root = tb_coll(&t, NULL, NULL, RY_MAP, 0), *m, *e;
   if (s->name)
     tb_word(&t, root, "name", s->name);
-  /* a multiphase scene has none of rhodsph's keys (refuse_other_scheme) */
-  const int mpx = s->scheme == RHOD_SCHEME_MULTIPHASE;
+  /* each scheme's keys where they always were: rhodsph's (s->rs) in time, particles,
+   * physics, scheme and refinement; the multiphase scheme's (s->mp) in scheme.name,
+   * phases and multiphase */
+  const rhod_rs_scene *rs = s->rs;
   m = tb_coll(&t, root, "time", RY_MAP, 0);
   tb_num(&t, m, "end", s->t_end);
   tb_num(&t, m, "output_every", s->output_every);
-  if (!mpx) {
-    tb_num(&t, m, "cfl", s->cfl);
-    tb_num(&t, m, "cfl_visc", s->cfl_visc);
-  }
-  tb_word(&t, m, "integrator",
-          strval_name(integrator_names, CYAML_ARRAY_LEN(integrator_names), (int)s->integrator));
-  if (!mpx && !s->stiffness_limit) /* present only when off, so checkpoints made before the
-                                      key resume */
-    tb_bool(&t, m, "stiffness_limit", s->stiffness_limit);
+  if (rs)
+    rhod_rs_tree_time_step(&t, m, rs);
+  tb_word(
+      &t, m, "integrator",
+      rhod_sl_enum_name(integrator_names, CYAML_ARRAY_LEN(integrator_names), (int)s->integrator));
+  if (rs)
+    rhod_rs_tree_time_limit(&t, m, rs);
   m = tb_coll(&t, root, "particles", RY_MAP, 0);
   tb_num(&t, m, "dx", s->dx);
   tb_num(&t, m, "radius_ratio", s->radius_ratio);
   tb_num(&t, m, "jitter", s->jitter);
-  if (!mpx && s->relax > 0) /* absent at 0, so checkpoints made before the key resume */
-    tb_num(&t, m, "relax", s->relax);
-  if (!mpx && s->relax_where != RHOD_RELAX_ALL) /* likewise absent at its default */
-    tb_word(
-        &t, m, "relax_where",
-        strval_name(relax_where_names, CYAML_ARRAY_LEN(relax_where_names), (int)s->relax_where));
+  if (rs)
+    rhod_rs_tree_particles(&t, m, rs);
   tb_word(&t, m, "kernel",
-          strval_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
+          rhod_sl_enum_name(kernel_names, CYAML_ARRAY_LEN(kernel_names), (int)s->kernel));
   m = tb_coll(&t, root, "physics", RY_MAP, 0);
-  if (!mpx) {
-    tb_num(&t, m, "rho0", s->rho0);
-    tb_num(&t, m, "c0", s->c0);
-    tb_num(&t, m, "mu", s->mu);
-  }
+  if (rs)
+    rhod_rs_tree_physics(&t, m, rs);
   tb_vec(&t, m, "gravity", s->gravity);
   m = tb_coll(&t, root, "scheme", RY_MAP, 0);
-  if (mpx) { /* absent for rhodsph, its default, so checkpoints made before the key resume */
+  if (s->scheme == RHOD_SCHEME_MULTIPHASE) { /* scheme.name is absent for rhodsph, its
+                                                default, so checkpoints made before the key
+                                                resume */
     tb_word(&t, m, "name",
-            strval_name(scheme_names, CYAML_ARRAY_LEN(scheme_names), (int)s->scheme));
+            rhod_sl_enum_name(scheme_names, CYAML_ARRAY_LEN(scheme_names), (int)s->scheme));
     rhod_mp_tree(&t, root, s->mp);
-    goto domain;
   }
-  tb_bool(&t, m, "riemann", s->riemann);
-  tb_bool(&t, m, "reconstruction", s->reconstruction);
-  tb_bool(&t, m, "shifting", s->shifting);
-  tb_num(&t, m, "shifting_a", s->shift_a);
-  tb_num(&t, m, "shifting_b", s->shift_b);
-  tb_num(&t, m, "shifting_eps", s->shift_eps);
-  tb_bool(&t, m, "acoustic_damper", s->acoustic_damper);
-  tb_num(&t, m, "alpha_ad", s->alpha_ad);
-  tb_bool(&t, m, "damper_step_limit", s->damper_step_limit);
-  tb_bool(&t, m, "tensile_control", s->tensile_control);
-  tb_word(&t, m, "shifting_switch",
-          strval_name(shifting_switch_names, CYAML_ARRAY_LEN(shifting_switch_names),
-                      (int)s->shifting_switch));
-  tb_bool(&t, m, "free_surface", s->free_surface);
-  double lambda[2] = {s->fs_lambda_low, s->fs_lambda_high};
-  tb_vec(&t, m, "free_surface_lambda", lambda);
-  tb_num(&t, m, "shepard_threshold", s->shepard_threshold);
-  tb_num(&t, m, "theta_threshold", s->theta_threshold);
-  tb_word(&t, m, "viscosity",
-          strval_name(viscosity_names, CYAML_ARRAY_LEN(viscosity_names), (int)s->viscosity));
-domain:
+  if (rs)
+    rhod_rs_tree_scheme(&t, m, rs);
   m = tb_coll(&t, root, "domain", RY_MAP, 0);
   if (s->has_domain) {
     tb_vec(&t, m, "min", s->domain_min);
@@ -2375,13 +2068,13 @@ domain:
   m = tb_coll(&t, root, "fluid", RY_SEQ, 0);
   for (unsigned i = 0; i < s->n_fluid; i++) {
     e = tb_coll(&t, m, NULL, RY_MAP, 0);
-    tb_shape(&t, e, &s->fluid[i].shape);
+    rhod_sl_shape(&t, e, &s->fluid[i].shape);
     tb_vec(&t, e, "velocity", s->fluid[i].velocity);
     tb_word(&t, e, "pressure",
-            strval_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
+            rhod_sl_enum_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
     if (s->fluid[i].surface_set) /* absent at its default, so older checkpoints resume */
       tb_num(&t, e, "surface", s->fluid[i].surface);
-    if (mpx)
+    if (s->mp)
       tb_word(&t, e, "phase", s->mp->phases[s->fluid[i].phase].name);
     const rhod_fluid_block *fb = &s->fluid[i];
     if (fb->flow != RHOD_FLOW_NONE) {
@@ -2413,9 +2106,9 @@ domain:
   m = tb_coll(&t, root, "walls", RY_SEQ, s->n_walls == 0);
   for (unsigned i = 0; i < s->n_walls; i++) {
     e = tb_coll(&t, m, NULL, RY_MAP, 0);
-    tb_shape(&t, e, &s->walls[i].shape);
+    rhod_sl_shape(&t, e, &s->walls[i].shape);
     tb_word(&t, e, "slip",
-            strval_name(slip_names, CYAML_ARRAY_LEN(slip_names), (int)s->walls[i].slip));
+            rhod_sl_enum_name(slip_names, CYAML_ARRAY_LEN(slip_names), (int)s->walls[i].slip));
     tb_bool(&t, e, "fluid_inside", s->walls[i].fluid_inside);
     const rhod_wall *w = &s->walls[i];
     if (w->moving_edges) { /* absent at rest, so older checkpoints resume */
@@ -2442,36 +2135,8 @@ domain:
     if (p->kind == RHOD_PROBE_FRONT)
       tb_vec(&t, b, "direction", p->direction);
   }
-  if (mpx)
-    goto output;
-  m = tb_coll(&t, root, "refinement", RY_MAP, 0);
-  tb_num(&t, m, "levels", s->levels);
-  tb_word(&t, m, "pattern",
-          strval_name(pattern_names, CYAML_ARRAY_LEN(pattern_names), (int)s->pattern));
-  e = tb_coll(&t, m, "regions", RY_SEQ, s->n_regions == 0);
-  for (unsigned i = 0; i < s->n_regions; i++) {
-    ry_node *r = tb_coll(&t, e, NULL, RY_MAP, 0);
-    tb_shape(&t, r, &s->regions[i].shape);
-    tb_num(&t, r, "level", s->regions[i].level);
-  }
-  tb_bool(&t, m, "dynamic", s->refine_dynamic);
-  tb_bool(&t, m, "free_surface", s->refine_free_surface);
-  if (s->refine_free_surface)
-    tb_num(&t, m, "surface_band", s->refine_band);
-  tb_num(&t, m, "crowding", s->refine_crowding);
-  tb_bool(&t, m, "walls", s->refine_walls);
-  tb_bool(&t, m, "coalesce", s->refine_coalesce);
-  if (s->refine_field) {
-    e = tb_coll(&t, m, "field", RY_MAP, 1);
-    tb_word(&t, e, "quantity",
-            strval_name(quantity_names, CYAML_ARRAY_LEN(quantity_names), (int)s->field_quantity));
-    if (s->field_above != HUGE_VAL)
-      tb_num(&t, e, "above", s->field_above);
-    if (s->field_below != -HUGE_VAL)
-      tb_num(&t, e, "below", s->field_below);
-    tb_num(&t, e, "from", s->field_from);
-  }
-output:
+  if (rs)
+    rhod_rs_tree_refinement(&t, root, rs);
   m = tb_coll(&t, root, "output", RY_MAP, 0);
   if (!s->picture_enabled) {
     tb_bool(&t, m, "picture", 0);
@@ -2479,7 +2144,7 @@ output:
   }
   m = tb_coll(&t, m, "picture", RY_MAP, 0);
   tb_word(&t, m, "field",
-          strval_name(field_names, CYAML_ARRAY_LEN(field_names), (int)s->picture_field));
+          rhod_sl_enum_name(field_names, CYAML_ARRAY_LEN(field_names), (int)s->picture_field));
   tb_num(&t, m, "width", s->picture_width);
   tb_bool(&t, m, "size_panel", s->picture_size_panel);
   if (s->picture_range_set)
@@ -2508,9 +2173,7 @@ void rhod_scene_free(rhod_scene *s) {
     free(s->walls[i].shape.points);
   for (unsigned i = 0; i < s->n_probes; i++)
     free(s->probes[i].name);
-  for (unsigned i = 0; i < s->n_regions; i++)
-    free(s->regions[i].shape.points);
-  free(s->regions);
+  rhod_rs_scene_free(s->rs);
   rhod_mp_scene_free(s->mp);
   free(s->fluid);
   free(s->walls);
@@ -2829,22 +2492,24 @@ int rhod_scene_warnings(const rhod_scene *s, char *buf, size_t len) {
       flow = hypot(b->flow_U, 2 * b->flow_UI); /* |tanh - tanh - 1| <= 1 for y1 < y2 */
     else if (b->flow == RHOD_FLOW_ROTATION) {
       double lo[2], hi[2];
-      shape_bbox(&b->shape, lo, hi);
+      rhod_sl_shape_bbox(&b->shape, lo, hi);
       const double dx = fmax(fabs(lo[0] - b->flow_center[0]), fabs(hi[0] - b->flow_center[0]));
       const double dy = fmax(fabs(lo[1] - b->flow_center[1]), fabs(hi[1] - b->flow_center[1]));
       flow = fabs(b->flow_omega) * hypot(dx, dy);
     }
     umax = fmax(umax, hypot(b->velocity[0], b->velocity[1]) + flow);
   }
-  double du = sqrt(2 * g * H) + umax, dp = s->rho0 * g * H;
-  double bound = 10 * fmax(du, s->rho0 > 0 ? sqrt(dp / s->rho0) : 0);
-  if (s->scheme == RHOD_SCHEME_RHODSPH && s->c0 < bound * (1 - 1e-12))
+  const rhod_rs_scene *rs = s->rs; /* physics.c0 and rho0 are rhodsph's */
+  const double rho0 = rs ? rs->rho0 : 0;
+  double du = sqrt(2 * g * H) + umax, dp = rho0 * g * H;
+  double bound = 10 * fmax(du, rho0 > 0 ? sqrt(dp / rho0) : 0);
+  if (rs && rs->c0 < bound * (1 - 1e-12))
     rhod_warn(
         &w,
         "%s: physics.c0: %g m/s is below the bound %.4g m/s of paper 002 Eq. 2, "
         "c0 >= 10 max(dU_max, sqrt(dP_max/rho0)), with dU_max = sqrt(2|g|H) + max|u0| = %.4g m/s, "
         "dP_max = rho0|g|H = %.4g Pa, H = %.4g m: the flow is not weakly compressible",
-        file, s->c0, bound, du, dp, H);
+        file, rs->c0, bound, du, dp, H);
 
   if (s->output_every > s->t_end)
     rhod_warn(&w,

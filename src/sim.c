@@ -28,6 +28,8 @@ static int in_shape(const rhod_shape *sh, double x, double y) {
   return inside;
 }
 
+int rhod_shape_contains(const rhod_shape *sh, double x, double y) { return in_shape(sh, x, y); }
+
 static void shape_box(const rhod_shape *sh, double lo[2], double hi[2]) {
   if (sh->kind == RHOD_SHAPE_RECT) {
     for (int a = 0; a < 2; a++)
@@ -94,20 +96,15 @@ static double jitter_rand(uint64_t *st) {
   return (double)(*st >> 11) / 9007199254740992.0 - 0.5;
 }
 
-/* The jitter given to the lattice as it is filled. With dynamic refinement the
- * lattice is filled unjittered, refined by the initial criteria cascade (whose splits
- * then fall on the finer lattices), and jittered afterwards, each particle by its own
- * size (restate_initial): jittered parents would give children that crowd their
- * neighbours' children. */
-static double lattice_jitter(const rhod_scene *sc) { return sc->refine_dynamic ? 0 : sc->jitter; }
+/* The jitter given to the lattice as it is filled: particles.jitter, or none where the
+ * scheme jitters the lattice itself (its fill_unjittered hook). */
+static double lattice_jitter(const rhod_sim *s) {
+  return s->ops->fill_unjittered && s->ops->fill_unjittered(s->sc) ? 0 : s->sc->jitter;
+}
 
-/* Finest initial level asked by the refinement regions at (x, y); 0 outside all. */
-static int region_level(const rhod_scene *sc, double x, double y) {
-  int l = 0;
-  for (unsigned r = 0; r < sc->n_regions; r++)
-    if (sc->regions[r].level > l && in_shape(&sc->regions[r].shape, x, y))
-      l = sc->regions[r].level;
-  return l;
+/* Finest initial level the scheme asks for at (x, y) (its fill_level hook); 0: dx. */
+static int region_level(const rhod_sim *s, double x, double y) {
+  return s->ops->fill_level ? s->ops->fill_level(s->sc, x, y) : 0;
 }
 
 int rhod_sim_block_at(const rhod_sim *s, double x, double y) {
@@ -260,12 +257,12 @@ static void block_empty_why(const rhod_sim *s, unsigned b, char *buf, size_t len
  * (Fig. 14) once the regions are at least 8 dx of their level apart. */
 static void fill_cell(rhod_sim *s, unsigned b, const double lo[2], double dx0, double ci, double cj,
                       double f, int l, double jx, double jy, uint64_t *rs, size_t *n, int write) {
-  if (region_level(s->sc, lo[0] + ci * dx0, lo[1] + cj * dx0) <= l) {
+  if (region_level(s, lo[0] + ci * dx0, lo[1] + cj * dx0) <= l) {
     emit(s, b, lo[0] + (ci + jx * f) * dx0, lo[1] + (cj + jy * f) * dx0, f * dx0, n, write);
     return;
   }
   for (int q = 0; q < 4; q++) {
-    const double jit = lattice_jitter(s->sc);
+    const double jit = lattice_jitter(s);
     const double j2x = jit * jitter_rand(rs), j2y = jit * jitter_rand(rs);
     fill_cell(s, b, lo, dx0, ci + ((q & 1) ? 0.25 : -0.25) * f, cj + ((q & 2) ? 0.25 : -0.25) * f,
               0.5 * f, l + 1, j2x, j2y, rs, n, write);
@@ -292,7 +289,7 @@ static int fill_fluid(rhod_sim *s, char *err, size_t errlen) {
            * deforms affinely under a strain field, where Fickian shifting (uniform
            * concentration) cannot act, until it collapses (seen on the Taylor-Green
            * vortex) */
-          const double jit = lattice_jitter(sc);
+          const double jit = lattice_jitter(s);
           const double jx = jit * jitter_rand(&rs), jy = jit * jitter_rand(&rs);
           fill_cell(s, b, lo, dx, i + 0.5, j + 0.5, 1.0, 0, jx, jy, &rs, &n, pass);
         }
@@ -351,12 +348,6 @@ static int engine_probe(rhod_probe_kind kind) {
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   memset(s, 0, sizeof *s);
   s->sc = sc;
-  if (sc->levels < 1 || sc->levels > RHOD_MAX_LEVELS) {
-    /* the loader never lets this through; a scene built by hand might */
-    snprintf(err, errlen, "%s: refinement.levels: %d is outside [1, %d]", sc->path, sc->levels,
-             RHOD_MAX_LEVELS);
-    return RHOD_ERR_SCENE;
-  }
   /* the lattice is not walked for a count the machine cannot hold (docs/choices.md
    * "load-time limits"): the loader refuses more than RHOD_MAX_PARTICLES, this the memory */
   const double est = rhod_scene_particle_estimate(sc);
@@ -402,9 +393,11 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     return RHOD_ERR_SCENE;
   }
   s->margin = sc->radius_ratio * sc->dx; /* particles.dx is the coarsest size (level 0) */
-  s->ops->geometry(sc, &s->dx_min, &s->mirror_ratio);
+  int st = s->ops->geometry(sc, &s->dx_min, &s->mirror_ratio, err, errlen);
+  if (st != RHOD_OK)
+    return st;
   s->mirror_ratio *= sc->radius_ratio;
-  int st = rhod_particles_init(&s->p, 1024);
+  st = rhod_particles_init(&s->p, 1024);
   if (st == RHOD_OK)
     st = rhod_boundary_init(&s->bnd, sc, s->lo, s->hi);
   if (st != RHOD_OK) {

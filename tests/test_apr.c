@@ -688,7 +688,7 @@ static void split_case_run(split_case *t, rhod_pattern pattern, unsigned long se
   const double dx = 0.01, c0 = 20, rho0 = 1000;
   const int nx = 20, ny = 20;
   t->sc = unit_scene(dx);
-  t->sc->pattern = pattern;
+  t->sc->rs->pattern = pattern;
   rhod_particles *p = &t->p;
   CU_ASSERT_EQUAL_FATAL(rhod_particles_init(p, (size_t)(nx * ny) + 8), RHOD_OK);
   add_block(p, 0, 0, nx, ny, dx, 0.5, &seed);
@@ -699,8 +699,8 @@ static void split_case_run(split_case *t, rhod_pattern pattern, unsigned long se
     p->ux[i] = (real)(f->u0x + f->dux * i), p->uy[i] = (real)(f->u0y + f->duy * i);
   }
   rhod_scene *sc = t->sc;
-  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
-  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  sc->rs->refine_field = 1, sc->rs->field_quantity = RHOD_QTY_PRESSURE;
+  sc->rs->field_above = HUGE_VAL, sc->rs->field_below = 1e30, sc->rs->field_from = 0;
   const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {(nx + 8) * dx, (ny + 8) * dx};
   mark_store(sc, p, &t->s, &t->c, &t->a, lo, hi, dx, dx / rhod_pattern_ratio(pattern));
   t->want = calloc((size_t)n0, 1);
@@ -962,8 +962,8 @@ static void test_split_strained_lattice(void) {
   p.next_id = p.n;
   const long n0 = (long)p.n;
   const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {nx * sx + 8 * dx, ny * sy + 8 * dx};
-  sc->refine_field = 1, sc->field_quantity = RHOD_QTY_PRESSURE;
-  sc->field_above = HUGE_VAL, sc->field_below = 1e30, sc->field_from = 0;
+  sc->rs->refine_field = 1, sc->rs->field_quantity = RHOD_QTY_PRESSURE;
+  sc->rs->field_above = HUGE_VAL, sc->rs->field_below = 1e30, sc->rs->field_from = 0;
   rhod_sph s;
   rhod_cells c;
   rhod_apr a;
@@ -1104,8 +1104,8 @@ static void coalesce_groups(rhod_pattern pattern) {
   const int N = rhod_pattern_children(pattern);
   const double dx = 0.01, eps = rhod_pattern_ratio(pattern), h = dx / eps, c0 = 20, rho0 = 1000;
   rhod_scene *sc = unit_scene(dx);
-  sc->refine_coalesce = 1;
-  sc->pattern = pattern;
+  sc->rs->refine_coalesce = 1;
+  sc->rs->pattern = pattern;
   rhod_particles p;
   CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, 800), RHOD_OK);
   unsigned long seed = 5;
@@ -1500,11 +1500,12 @@ static void test_triangle_run(void) {
  * (perf/bench_common.h once did that: cells twice too large, 1.3x the cost). */
 static void test_levels_guard(void) {
   rhod_scene *sc = unit_scene(0.01);
-  sc->levels = 0;
+  sc->rs->levels = 0;
   rhod_sim *s = calloc(1, sizeof *s);
   char err[256] = "";
   CU_ASSERT_EQUAL(rhod_sim_init(s, sc, err, sizeof err), RHOD_ERR_SCENE);
   CU_ASSERT_PTR_NOT_NULL(strstr(err, "refinement.levels"));
+  rhod_sim_free(s);
   free(s);
   free(sc);
 }

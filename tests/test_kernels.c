@@ -270,12 +270,12 @@ static void test_renormalised_gradient_linear(void) {
  * quadratic velocity u = (x^2 - 2xy + 3y^2, -x^2 - 2xy + y^2), lap u = (8, 0) 1/m s,
  * no pressure and only viscosity acting: acc = mu lap u / rho. */
 static void visc_consistent(rhod_scene *sc) {
-  sc->mu = 1, sc->viscosity = RHOD_VISCOSITY_CONSISTENT;
-  sc->shifting = sc->acoustic_damper = sc->free_surface = 0;
+  sc->rs->mu = 1, sc->rs->viscosity = RHOD_VISCOSITY_CONSISTENT;
+  sc->rs->shifting = sc->rs->acoustic_damper = sc->rs->free_surface = 0;
 }
 static void visc_monaghan(rhod_scene *sc) {
   visc_consistent(sc);
-  sc->viscosity = RHOD_VISCOSITY_MONAGHAN;
+  sc->rs->viscosity = RHOD_VISCOSITY_MONAGHAN;
 }
 static double viscous_error(void (*edit)(rhod_scene *), int *count) {
   cloud cl;
@@ -630,7 +630,7 @@ static const double BJ_H = 0.01;
 static void bj_patch(int sw, bj_run *o) {
   const double h = BJ_H, ax = BJ_NF * h, ay = 0.5 * BJ_NF * h;
   rhod_scene *sc = unit_scene(h);
-  sc->shifting_switch = (rhod_shifting_switch)sw;
+  sc->rs->shifting_switch = (rhod_shifting_switch)sw;
   rhod_particles p;
   rhod_particles_init(&p, BJ_N + 16);
   unsigned long seed = 53;

@@ -3,6 +3,7 @@
  * as run (YAML and flattened parameters) and the Eq. 2 warning on c0. */
 #define _POSIX_C_SOURCE 200809L
 
+#include "rhod/rhodsph/scene.h"
 #include "rhod/scene.h"
 #include "test_scene_load.h"
 
@@ -22,33 +23,33 @@ static void test_full_scene(void) {
   CU_ASSERT_STRING_EQUAL(s->path, GOOD("full.yaml"));
   CLOSE(s->t_end, 1.0);
   CLOSE(s->output_every, 0.05);
-  CLOSE(s->cfl, 0.4);
-  CLOSE(s->cfl_visc, 0.02);
-  CU_ASSERT_FALSE(s->stiffness_limit);
+  CLOSE(s->rs->cfl, 0.4);
+  CLOSE(s->rs->cfl_visc, 0.02);
+  CU_ASSERT_FALSE(s->rs->stiffness_limit);
   CLOSE(s->dx, 0.01);
   CLOSE(s->radius_ratio, 3);
   CU_ASSERT_EQUAL(s->kernel, RHOD_KERNEL_QUINTIC);
-  CLOSE(s->rho0, 998);
-  CLOSE(s->c0, 80);
-  CLOSE(s->mu, 0.001);
+  CLOSE(s->rs->rho0, 998);
+  CLOSE(s->rs->c0, 80);
+  CLOSE(s->rs->mu, 0.001);
   CLOSE(s->gravity[0], 0);
   CLOSE(s->gravity[1], -9.81);
-  CU_ASSERT_FALSE(s->riemann);
-  CU_ASSERT_FALSE(s->reconstruction);
-  CU_ASSERT_FALSE(s->shifting);
-  CLOSE(s->shift_a, 0.4);
-  CLOSE(s->shift_b, 0.04);
-  CLOSE(s->shift_eps, 4e-4);
-  CU_ASSERT_FALSE(s->acoustic_damper);
-  CLOSE(s->alpha_ad, 0.5);
-  CU_ASSERT_FALSE(s->damper_step_limit);
-  CU_ASSERT_TRUE(s->tensile_control);
-  CU_ASSERT_EQUAL(s->shifting_switch, RHOD_SHSW_ALL);
-  CU_ASSERT_FALSE(s->free_surface);
-  CLOSE(s->fs_lambda_low, 0.25);
-  CLOSE(s->fs_lambda_high, 0.7);
-  CLOSE(s->shepard_threshold, 0.8);
-  CLOSE(s->theta_threshold, 0.9);
+  CU_ASSERT_FALSE(s->rs->riemann);
+  CU_ASSERT_FALSE(s->rs->reconstruction);
+  CU_ASSERT_FALSE(s->rs->shifting);
+  CLOSE(s->rs->shift_a, 0.4);
+  CLOSE(s->rs->shift_b, 0.04);
+  CLOSE(s->rs->shift_eps, 4e-4);
+  CU_ASSERT_FALSE(s->rs->acoustic_damper);
+  CLOSE(s->rs->alpha_ad, 0.5);
+  CU_ASSERT_FALSE(s->rs->damper_step_limit);
+  CU_ASSERT_TRUE(s->rs->tensile_control);
+  CU_ASSERT_EQUAL(s->rs->shifting_switch, RHOD_SHSW_ALL);
+  CU_ASSERT_FALSE(s->rs->free_surface);
+  CLOSE(s->rs->fs_lambda_low, 0.25);
+  CLOSE(s->rs->fs_lambda_high, 0.7);
+  CLOSE(s->rs->shepard_threshold, 0.8);
+  CLOSE(s->rs->theta_threshold, 0.9);
   CU_ASSERT_TRUE(s->has_domain);
   CLOSE(s->domain_min[0], 0);
   CLOSE(s->domain_max[0], 4);
@@ -113,31 +114,31 @@ static void test_defaults(void) {
   if (!s)
     return;
   CU_ASSERT_STRING_EQUAL(s->name, "minimal"); /* from the file name */
-  CLOSE(s->cfl, 0.5);
-  CLOSE(s->cfl_visc, 0.025);
+  CLOSE(s->rs->cfl, 0.5);
+  CLOSE(s->rs->cfl_visc, 0.025);
   CLOSE(s->radius_ratio, 4);
   CU_ASSERT_EQUAL(s->kernel, RHOD_KERNEL_WENDLAND_C2);
-  CLOSE(s->rho0, 1000);
-  CLOSE(s->mu, 0);
+  CLOSE(s->rs->rho0, 1000);
+  CLOSE(s->rs->mu, 0);
   CLOSE(s->gravity[0], 0);
   CLOSE(s->gravity[1], 0);
-  CU_ASSERT_TRUE(s->riemann);
-  CU_ASSERT_TRUE(s->reconstruction);
-  CU_ASSERT_TRUE(s->shifting);
-  CLOSE(s->shift_a, 0.5);
-  CLOSE(s->shift_b, 0.05);
-  CLOSE(s->shift_eps, 5e-4);
-  CU_ASSERT_TRUE(s->acoustic_damper);
-  CLOSE(s->alpha_ad, 1);
-  CU_ASSERT_TRUE(s->damper_step_limit);
-  CU_ASSERT_TRUE(s->stiffness_limit);
-  CU_ASSERT_FALSE(s->tensile_control);
-  CU_ASSERT_EQUAL(s->shifting_switch, RHOD_SHSW_NONE);
-  CU_ASSERT_TRUE(s->free_surface);
-  CLOSE(s->fs_lambda_low, 0.2);
-  CLOSE(s->fs_lambda_high, 0.75);
-  CLOSE(s->shepard_threshold, 0.85);
-  CLOSE(s->theta_threshold, 0.95);
+  CU_ASSERT_TRUE(s->rs->riemann);
+  CU_ASSERT_TRUE(s->rs->reconstruction);
+  CU_ASSERT_TRUE(s->rs->shifting);
+  CLOSE(s->rs->shift_a, 0.5);
+  CLOSE(s->rs->shift_b, 0.05);
+  CLOSE(s->rs->shift_eps, 5e-4);
+  CU_ASSERT_TRUE(s->rs->acoustic_damper);
+  CLOSE(s->rs->alpha_ad, 1);
+  CU_ASSERT_TRUE(s->rs->damper_step_limit);
+  CU_ASSERT_TRUE(s->rs->stiffness_limit);
+  CU_ASSERT_FALSE(s->rs->tensile_control);
+  CU_ASSERT_EQUAL(s->rs->shifting_switch, RHOD_SHSW_NONE);
+  CU_ASSERT_TRUE(s->rs->free_surface);
+  CLOSE(s->rs->fs_lambda_low, 0.2);
+  CLOSE(s->rs->fs_lambda_high, 0.75);
+  CLOSE(s->rs->shepard_threshold, 0.85);
+  CLOSE(s->rs->theta_threshold, 0.95);
   /* no domain: the bounding box of the fluid (no walls here) */
   CU_ASSERT_FALSE(s->has_domain);
   CLOSE(s->domain_min[0], 0);
@@ -195,7 +196,7 @@ static void test_overrides(void) {
   CLOSE(s->gravity[0], 0.25);
   CLOSE(s->gravity[1], -1);
   CLOSE(s->fluid[0].velocity[0], 1);
-  CLOSE(s->cfl, 0.3);
+  CLOSE(s->rs->cfl, 0.3);
   CU_ASSERT_EQUAL(s->picture_width, 1024);
   CU_ASSERT_EQUAL_FATAL(s->n_fluid, 2);
   CU_ASSERT_EQUAL(s->fluid[1].shape.kind, RHOD_SHAPE_CIRCLE);
@@ -203,8 +204,8 @@ static void test_overrides(void) {
   CU_ASSERT_EQUAL_FATAL(s->n_probes, 1);
   CU_ASSERT_EQUAL(s->probes[0].kind, RHOD_PROBE_FRONT);
   CU_ASSERT_STRING_EQUAL(s->probes[0].name, "X");
-  CU_ASSERT_FALSE(s->riemann);
-  CU_ASSERT_EQUAL(s->shifting_switch, RHOD_SHSW_BALANCED_MOMENTUM);
+  CU_ASSERT_FALSE(s->rs->riemann);
+  CU_ASSERT_EQUAL(s->rs->shifting_switch, RHOD_SHSW_BALANCED_MOMENTUM);
   CU_ASSERT_STRING_EQUAL(s->name, "renamed");
   /* the scene as run holds the overridden values */
   CU_ASSERT_PTR_NOT_NULL(strstr(s->yaml, "end: 0.5\n"));
@@ -431,7 +432,7 @@ static void test_as_run_round_trip(void) {
   remove(tmp);
   if (b) {
     CU_ASSERT_STRING_EQUAL(a->yaml, b->yaml);
-    CLOSE(b->c0, 90);
+    CLOSE(b->rs->c0, 90);
     CU_ASSERT_EQUAL(b->n_probes, a->n_probes);
     CU_ASSERT_EQUAL(b->fluid[2].shape.n_points, 3);
     CLOSE(b->fluid[2].shape.points[0][0], a->fluid[2].shape.points[0][0]);

@@ -6,6 +6,7 @@
 
 #include "cunit_main.h"
 #include "rhod/io.h"
+#include "rhod/rhodsph/scene.h"
 #include "rhod/scene.h"
 #include "rhod/sim.h"
 

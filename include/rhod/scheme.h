@@ -29,8 +29,21 @@ typedef struct {
 typedef struct rhod_scheme_ops {
   const char *name; /* scheme.name */
   /* Before the fill (s->sc, s->lo, s->hi set): the finest particle size the scene allows,
-   * and how far wall mirrors reach, in units of a particle's kernel radius R_i. */
-  void (*geometry)(const rhod_scene *sc, double *dx_min, double *mirror_reach);
+   * and how far wall mirrors reach, in units of a particle's kernel radius R_i. A status,
+   * with a one-line message in err, when the scene is not one the scheme can run (a scene
+   * built by hand without the scheme's keys or with values the loader refuses). */
+  int (*geometry)(const rhod_scene *sc, double *dx_min, double *mirror_reach, char *err,
+                  size_t errlen);
+  /* The fill's initial levels (may be NULL: one level): the finest level asked at (x, y),
+   * 0 for particles.dx. The fill puts one particle in a lattice cell of level l (size
+   * particles.dx / 2^l) where the level asked at the cell's centre is at most l, else
+   * its four quarter cells of level l + 1, each refined again where asked: the lattices
+   * nest as a quadtree. */
+  int (*fill_level)(const rhod_scene *sc, double x, double y);
+  /* Whether the fill leaves particles.jitter to the scheme (may be NULL: it does not): the
+   * lattice is then filled unjittered, and the scheme jitters it itself in `start`
+   * (rhod_sim_restate). */
+  int (*fill_unjittered)(const rhod_scene *sc);
   /* The initial state of particle k of fluid block b at (x, y), size dx: every persistent
    * field the scheme's variables need (the engine has set nothing but the id). Called on
    * the host during the fill and by rhod_sim_restate. */

@@ -54,6 +54,9 @@ void rhod_sim_free(rhod_sim *s);
 /* For schemes. The fluid block that owns (x, y): the first whose shape holds it, if it is
  * fluid (inside the domain, not behind a wall); -1 otherwise. */
 int rhod_sim_block_at(const rhod_sim *s, double x, double y);
+/* Whether (x, y) lies in the shape (its boundary included; a polygon by the even-odd
+ * rule), as the fill tests it. */
+int rhod_shape_contains(const rhod_shape *sh, double x, double y);
 /* The initial flow of block b at (x, y) for a fluid of density rho0: the block's velocity
  * plus its analytic flow (fluid.N.initial), and that flow's pressure (0 without one). */
 void rhod_sim_initial_flow(const rhod_sim *s, unsigned b, double x, double y, double rho0,

@@ -62,21 +62,21 @@
 
 int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   memset(a, 0, sizeof *a);
-  a->active = sc->refine_dynamic;
+  a->active = sc->rs->refine_dynamic;
   a->dx_min = (real)dx_min;
-  a->free_surface = sc->refine_free_surface;
-  a->band = (real)sc->refine_band;
-  a->crowd = (real)sc->refine_crowding;
-  a->walls = sc->refine_walls;
-  a->field = sc->refine_field;
-  a->qty = sc->field_quantity;
-  a->above = (real)fmin(sc->field_above, 1e30);
-  a->below = (real)fmax(sc->field_below, -1e30);
-  a->from = (real)sc->field_from;
-  a->nsplit = rhod_pattern_children(sc->pattern);
-  a->eps = (real)rhod_pattern_ratio(sc->pattern);
-  a->ieps = (real)(1 / rhod_pattern_ratio(sc->pattern));
-  a->coalesce = sc->refine_coalesce;
+  a->free_surface = sc->rs->refine_free_surface;
+  a->band = (real)sc->rs->refine_band;
+  a->crowd = (real)sc->rs->refine_crowding;
+  a->walls = sc->rs->refine_walls;
+  a->field = sc->rs->refine_field;
+  a->qty = sc->rs->field_quantity;
+  a->above = (real)fmin(sc->rs->field_above, 1e30);
+  a->below = (real)fmax(sc->rs->field_below, -1e30);
+  a->from = (real)sc->rs->field_from;
+  a->nsplit = rhod_pattern_children(sc->rs->pattern);
+  a->eps = (real)rhod_pattern_ratio(sc->rs->pattern);
+  a->ieps = (real)(1 / rhod_pattern_ratio(sc->rs->pattern));
+  a->coalesce = sc->rs->refine_coalesce;
   a->dx_max = (real)sc->dx;
   return RHOD_OK;
 }

@@ -8,9 +8,12 @@
 #include <string.h>
 
 /* One resolution: the finest size is particles.dx, and wall mirrors reach R_i. */
-static void mp_geometry(const rhod_scene *sc, double *dx_min, double *mirror_reach) {
+static int mp_geometry(const rhod_scene *sc, double *dx_min, double *mirror_reach, char *err,
+                       size_t errlen) {
+  (void)err, (void)errlen;
   *dx_min = sc->dx;
   *mirror_reach = 1;
+  return RHOD_OK;
 }
 
 /* Particle k of block b: the block's phase and flow, the hydrostatic pressure where asked

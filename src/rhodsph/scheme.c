@@ -8,20 +8,51 @@
 
 /* Before the fill: the finest size (triangle: by the multiplications the splits make) and
  * the wall mirrors' reach. */
-static void rs_geometry(const rhod_scene *sc, double *dx_min, double *mirror_reach) {
-  *dx_min = ldexp(sc->dx, -(sc->levels - 1));
-  if (sc->pattern == RHOD_PATTERN_TRIANGLE) {
+static int rs_geometry(const rhod_scene *sc, double *dx_min, double *mirror_reach, char *err,
+                       size_t errlen) {
+  if (!sc->rs) { /* the loader always makes it; a scene built by hand might lack it */
+    snprintf(err, errlen, "%s: scheme.name: rhodsph, but the scene holds none of its keys",
+             sc->path);
+    return RHOD_ERR_SCENE;
+  }
+  if (sc->rs->levels < 1 || sc->rs->levels > RHOD_MAX_LEVELS) {
+    /* the loader never lets this through; a scene built by hand might */
+    snprintf(err, errlen, "%s: refinement.levels: %d is outside [1, %d]", sc->path, sc->rs->levels,
+             RHOD_MAX_LEVELS);
+    return RHOD_ERR_SCENE;
+  }
+  *dx_min = ldexp(sc->dx, -(sc->rs->levels - 1));
+  if (sc->rs->pattern == RHOD_PATTERN_TRIANGLE) {
     real dmin = (real)sc->dx;
-    for (int l = 1; l < sc->levels; l++)
-      dmin *= (real)(1 / rhod_pattern_ratio(sc->pattern));
+    for (int l = 1; l < sc->rs->levels; l++)
+      dmin *= (real)(1 / rhod_pattern_ratio(sc->rs->pattern));
     *dx_min = dmin;
   }
   /* Wall mirrors: a fluid particle's ghost is needed by every particle whose support
    * crosses the wall. With one size that is within R_i of the wall; with mixed sizes
    * a neighbour may be up to twice as large (criterion 1 keeps sizes in a support
    * within a factor 2), so mirrors reach 2 R_i. */
-  *mirror_reach = sc->levels > 1 ? 2 : 1;
+  *mirror_reach = sc->rs->levels > 1 ? 2 : 1;
+  return RHOD_OK;
 }
+
+/* The fill's initial levels: the finest refinement region containing the point
+ * (refinement.regions, paper 002 Sec. VI C, Fig. 14: the nested lattices of its initial
+ * setup); 0 outside all. */
+static int rs_fill_level(const rhod_scene *sc, double x, double y) {
+  const rhod_rs_scene *r = sc->rs;
+  int l = 0;
+  for (unsigned k = 0; k < r->n_regions; k++)
+    if (r->regions[k].level > l && rhod_shape_contains(&r->regions[k].shape, x, y))
+      l = r->regions[k].level;
+  return l;
+}
+
+/* With dynamic refinement the lattice is filled unjittered, refined by the initial
+ * criteria cascade (whose splits then fall on the finer lattices), and jittered
+ * afterwards, each particle by its own size (refine_initial): jittered parents would give
+ * children that crowd their neighbours' children. */
+static int rs_fill_unjittered(const rhod_scene *sc) { return sc->rs->refine_dynamic; }
 
 /* Particle k of size dx at (x, y) with the initial state of block b: the block's flow,
  * the hydrostatic pressure where asked, the density of Eq. 2 and m = rho V. */
@@ -29,20 +60,20 @@ static void rs_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
   rhod_particles *p = &s->p;
-  const double c2 = sc->c0 * sc->c0;
+  const double c2 = sc->rs->c0 * sc->rs->c0;
   double P = 0;
   if (B->pressure == RHOD_INIT_HYDROSTATIC) {
     /* paper 002 Sec. VI A: P = rho0 c0^2 (exp(g.(x - x_FS)/c0^2) - 1), the free surface
      * at fluid.N.surface (default the block's top along -g) */
     double g;
     const double depth = rhod_sim_block_depth(s, b, x, y, &g);
-    P = sc->rho0 * c2 * (exp(g * depth / c2) - 1);
+    P = sc->rs->rho0 * c2 * (exp(g * depth / c2) - 1);
   }
   double u, v, Pf;
-  rhod_sim_initial_flow(s, b, x, y, sc->rho0, &u, &v, &Pf);
+  rhod_sim_initial_flow(s, b, x, y, sc->rs->rho0, &u, &v, &Pf);
   if (B->flow != RHOD_FLOW_NONE)
     P += Pf;
-  const double rho = sc->rho0 + P / c2; /* Eq. 2 */
+  const double rho = sc->rs->rho0 + P / c2; /* Eq. 2 */
   p->x[k] = (real)x;
   p->y[k] = (real)y;
   p->ux[k] = (real)u;
@@ -87,7 +118,7 @@ static int rs_init(rhod_sim *s, char *err, size_t errlen) {
     snprintf(err, errlen,
              "%s: physics.c0 = %g m/s, physics.rho0 = %g kg/m^3: 1/c0 or 1/rho0 is not a finite "
              "number in %s precision",
-             sc->path, sc->c0, sc->rho0, RHOD_REAL_NAME);
+             sc->path, sc->rs->c0, sc->rs->rho0, RHOD_REAL_NAME);
     return st;
   }
   if (st != RHOD_OK) {
@@ -117,11 +148,11 @@ static int relax_initial(rhod_sim *s) {
     blk[p->id[k]] = rhod_sim_block_at(s, p->x[k], p->y[k]);
   /* particles.relax_where: jumps: the largest size present bounds the test's gather */
   real jumps_dx = 0;
-  if (s->sc->relax_where == RHOD_RELAX_JUMPS)
+  if (s->sc->rs->relax_where == RHOD_RELAX_JUMPS)
     for (size_t k = 0; k < p->n; k++)
       jumps_dx = p->dx[k] > jumps_dx ? p->dx[k] : jumps_dx;
   int st = RHOD_OK;
-  for (int it = 0; it < s->sc->relax && st == RHOD_OK; it++) {
+  for (int it = 0; it < s->sc->rs->relax && st == RHOD_OK; it++) {
     rhod_sph_relax(&rs->sph, p, &s->cells, jumps_dx);
     rhod_walls_guard(&s->bnd, p);
     st = rhod_sim_prepare(s, 1);
@@ -146,7 +177,7 @@ static int refine_initial(rhod_sim *s, char *err, size_t errlen) {
    * levels - 1 rounds are not always enough (the dam break still split 64, 139 and 507
    * particles in its first step at three, four and seven levels with that limit); the
    * cap of 4 levels rounds only bounds a cascade that would not settle. */
-  for (int round = 1; round < 4 * sc->levels; round++) {
+  for (int round = 1; round < 4 * sc->rs->levels; round++) {
     rhod_sph_rhs(&rs->sph, p, &s->cells, (real)s->dt);
     st = rhod_apr_mark(&rs->apr, &rs->sph, p, &s->cells, &s->bnd, 0, 0);
     const long split = st == RHOD_OK ? rhod_apr_split(&rs->apr, &rs->sph, p, &s->bnd) : -1;
@@ -172,7 +203,7 @@ static int rs_start(rhod_sim *s, char *err, size_t errlen) {
   int st = RHOD_OK;
   if (rs->apr.active)
     st = refine_initial(s, err, errlen);
-  if (st == RHOD_OK && s->sc->relax > 0 && (st = relax_initial(s)) != RHOD_OK)
+  if (st == RHOD_OK && s->sc->rs->relax > 0 && (st = relax_initial(s)) != RHOD_OK)
     snprintf(err, errlen, "out of memory relaxing the initial particles");
   return st;
 }
@@ -377,6 +408,8 @@ static int rs_load(rhod_sim *s, const rhod_checkpoint *ck, char *err, size_t err
 const rhod_scheme_ops rhod_rhodsph_ops = {
     .name = "rhodsph",
     .geometry = rs_geometry,
+    .fill_level = rs_fill_level,
+    .fill_unjittered = rs_fill_unjittered,
     .initial_state = rs_initial_state,
     .init = rs_init,
     .start = rs_start,

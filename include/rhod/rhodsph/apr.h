@@ -18,8 +18,8 @@
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/particles.h"
+#include "rhod/rhodsph/scene.h"
 #include "rhod/rhodsph/sph.h"
-#include "rhod/scene.h"
 
 typedef struct {
   int active;       /* dynamic refinement on */

@@ -6,7 +6,7 @@
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/particles.h"
-#include "rhod/scene.h"
+#include "rhod/rhodsph/scene.h"
 
 /* rhod_sph_dt's binding limit */
 enum { RHOD_DT_BY_EQ11, RHOD_DT_BY_DAMPER, RHOD_DT_BY_STIFFNESS };
