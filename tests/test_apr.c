@@ -1510,6 +1510,20 @@ static void test_levels_guard(void) {
   free(sc);
 }
 
+/* A rhodsph scene built by hand without its keys (rhod_scene.rs NULL, as for a multiphase
+ * scene) is refused by the scheme's geometry hook, not run on a NULL pointer. */
+static void test_keys_guard(void) {
+  rhod_scene *sc = unit_scene(0.01);
+  sc->rs = NULL; /* unit_scene's keys stay in its allocation: free(sc) frees them */
+  rhod_sim *s = calloc(1, sizeof *s);
+  char err[256] = "";
+  CU_ASSERT_EQUAL(rhod_sim_init(s, sc, err, sizeof err), RHOD_ERR_SCENE);
+  CU_ASSERT_PTR_NOT_NULL(strstr(err, "none of its keys"));
+  rhod_sim_free(s);
+  free(s);
+  free(sc);
+}
+
 /* ------------------------------------------------------------------------------------ */
 /* 6. refinement.levels: 2 without any split is the single-resolution run                */
 
@@ -1758,6 +1772,7 @@ int main(void) {
       {"initial relaxation: grad C falls, surface and state kept", test_initial_relaxation},
       {"relaxation at the size jumps only: the lattice elsewhere kept", test_relax_at_jumps},
       {"a hand-made scene without levels is refused", test_levels_guard},
+      {"a hand-made rhodsph scene without its keys is refused", test_keys_guard},
       {"snapshot free-surface flags, across levels and splits", test_free_surface_flags},
       {"levels 2 without splits = single resolution", test_equal_sizes_single_resolution},
       {"... also in a corner of the tank", test_equal_sizes_single_resolution_corner},
