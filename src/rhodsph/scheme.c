@@ -232,7 +232,8 @@ static int rs_end_step(rhod_sim *s) {
     return RHOD_OK;
   if (rhod_apr_split(&rs->apr, &rs->sph, p, &s->bnd) < 0)
     return RHOD_ERR_MEMORY;
-  rhod_apr_coalesce(&rs->apr, p);
+  if (rhod_apr_coalesce(&rs->apr, p) < 0)
+    return RHOD_ERR_MEMORY;
   if (rs->apr.split_last > 0 || rs->apr.merged_last > 0 || rs->apr.absorbed_last > 0)
     s->dt = rhod_sph_dt(&rs->sph, p);
   return RHOD_OK;
