@@ -1,9 +1,10 @@
 /* Checkpoint writing and reading (checkpoint.h). Records in order:
  *   "RHODCKP1" u32 version u32 sizeof(real)
  *   f64 t next_out next_probe next_checkpoint checkpoint_every
- *   i64 step reflected splits merges (version 2; version 1 has no splits, merges)
- *   f64 stiffness (version 3)
- *   i64 absorbed, f64 ke_merged ke_absorbed (version 4)
+ *   i64 step reflected
+ *   versions 2 to 6 only: i64 splits merges (version 2), f64 stiffness (version 3),
+ *     i64 absorbed, f64 ke_merged ke_absorbed (version 4): RHOD-SPH's counters, read as
+ *     extras (checkpoint.h); version 7 has them among the extras RHOD-SPH saves
  *   f64 picture_range[2] (version 5; NaN NaN: no range fixed yet)
  *   i32 nextra, (str name, f64 value)[nextra] (version 6: the scheme's scalars)
  *   u64 probes_bytes   i32 nsnap, f64[nsnap] times, u64[nsnap] counts
@@ -24,8 +25,12 @@
 #define CK_MAGIC "RHODCKP1"
 /* 2: the split and merge totals; 3: the stiffness limit's measure; 4: the absorbed
  * stragglers' total and the energy coalescing took out; 5: the pictures' colour range
- * fixed at the first picture; 6: the scheme's named scalars; 1 to 5 are still read */
-#define CK_VERSION 6u
+ * fixed at the first picture; 6: the scheme's named scalars; 7: the counters of 2 to 4
+ * among them (the engine knows no scheme's counters); 1 to 6 are still read */
+#define CK_VERSION 7u
+
+const char *const rhod_ck_legacy_extra[RHOD_CK_LEGACY_EXTRAS] = {
+    "splits", "merges", "stiffness", "absorbed", "ke_merged", "ke_absorbed"};
 #define CK_MAX_COUNT 100000000u /* sanity bound on any count (particles, strings, ...) */
 #define CK_MAX_PROBES_BYTES ((uint64_t)1 << 40) /* probes.csv: 1 TiB */
 
@@ -86,12 +91,6 @@ int rhod_checkpoint_write(const char *path, const rhod_checkpoint *ck, rhod_part
   put_f64(&w, ck->checkpoint_every);
   put_i64(&w, ck->step);
   put_i64(&w, ck->reflected);
-  put_i64(&w, ck->splits);
-  put_i64(&w, ck->merges);
-  put_f64(&w, ck->stiffness);
-  put_i64(&w, ck->absorbed);
-  put_f64(&w, ck->ke_merged);
-  put_f64(&w, ck->ke_absorbed);
   put_f64(&w, ck->picture_range[0]);
   put_f64(&w, ck->picture_range[1]);
   put_i32(&w, ck->nextra);
@@ -342,21 +341,12 @@ static int validate(const rhod_checkpoint *ck, const char *path, char *err, size
   const struct {
     const char *name;
     int64_t v;
-  } counts[] = {{"step", ck->step},
-                {"reflected", ck->reflected},
-                {"splits", ck->splits},
-                {"merges", ck->merges},
-                {"absorbed", ck->absorbed}};
-  for (int i = 0; i < 5; i++)
+  } counts[] = {{"step", ck->step}, {"reflected", ck->reflected}};
+  for (int i = 0; i < 2; i++)
     if (counts[i].v < 0)
       return bad_field(err, errlen, path, counts[i].name, "%lld, must be >= 0",
                        (long long)counts[i].v);
-  if (!(ck->stiffness >= 0 && ck->stiffness < HUGE_VAL))
-    return bad_field(err, errlen, path, "stiffness", "%g, must be finite and >= 0", ck->stiffness);
-  if (!isfinite(ck->ke_merged))
-    return bad_field(err, errlen, path, "ke_merged", "not a finite number");
-  if (!isfinite(ck->ke_absorbed))
-    return bad_field(err, errlen, path, "ke_absorbed", "not a finite number");
+  /* the scheme's scalars: its load judges their values */
   const double *pr = ck->picture_range;
   if (!(isnan(pr[0]) && isnan(pr[1])) && !(isfinite(pr[0]) && isfinite(pr[1]) && pr[0] < pr[1]))
     return bad_field(err, errlen, path, "picture_range",
@@ -411,16 +401,19 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
   get(r, &ck->checkpoint_every, 8, "checkpoint_every");
   get(r, &ck->step, 8, "step");
   get(r, &ck->reflected, 8, "reflected");
-  if (version >= 2) {
-    get(r, &ck->splits, 8, "splits");
-    get(r, &ck->merges, 8, "merges");
+  /* versions 2 to 6: RHOD-SPH's counters in fixed fields, kept for the extras below */
+  int64_t splits = 0, merges = 0, absorbed = 0;
+  double stiffness = 0, ke_merged = 0, ke_absorbed = 0;
+  if (version >= 2 && version < 7) {
+    get(r, &splits, 8, "splits");
+    get(r, &merges, 8, "merges");
   }
-  if (version >= 3)
-    get(r, &ck->stiffness, 8, "stiffness");
-  if (version >= 4) {
-    get(r, &ck->absorbed, 8, "absorbed");
-    get(r, &ck->ke_merged, 8, "ke_merged");
-    get(r, &ck->ke_absorbed, 8, "ke_absorbed");
+  if (version >= 3 && version < 7)
+    get(r, &stiffness, 8, "stiffness");
+  if (version >= 4 && version < 7) {
+    get(r, &absorbed, 8, "absorbed");
+    get(r, &ke_merged, 8, "ke_merged");
+    get(r, &ke_absorbed, 8, "ke_absorbed");
   }
   ck->picture_range[0] = ck->picture_range[1] = NAN;
   if (version >= 5) {
@@ -443,6 +436,20 @@ static int parse(rd *r, rhod_checkpoint *ck, const char *path, char *err, size_t
         strcpy(ck->extra_name[i], name);
       free(name);
       get(r, &ck->extra[i], 8, "extra value");
+    }
+  }
+  if (version < 7 && !r->bad) {
+    /* the fixed fields as the extras RHOD-SPH saves since version 7 (in the order of
+     * rhod_ck_legacy_extra), after the file's own */
+    const double v[RHOD_CK_LEGACY_EXTRAS] = {(double)splits,   (double)merges, stiffness,
+                                             (double)absorbed, ke_merged,      ke_absorbed};
+    if (ck->nextra > RHOD_CK_MAX_EXTRAS - RHOD_CK_LEGACY_EXTRAS) {
+      r->bad = 1;
+      r->what = "nextra";
+    }
+    for (int i = 0; i < RHOD_CK_LEGACY_EXTRAS && !r->bad; i++) {
+      snprintf(ck->extra_name[ck->nextra], sizeof ck->extra_name[0], "%s", rhod_ck_legacy_extra[i]);
+      ck->extra[ck->nextra++] = v[i];
     }
   }
   get(r, &ck->probes_bytes, 8, "probes_bytes");

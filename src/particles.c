@@ -1,5 +1,6 @@
 /* Particle store: allocation, device mapping, growth and reordering. */
 #include "rhod/particles.h"
+#include "rhod/cells.h"
 #include "rhod/device.h"
 #include "rhod/status.h"
 #include <stdlib.h>
@@ -184,8 +185,44 @@ void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count) 
     if (f->persistent == 1)
       gather_bytes(*f->ptr, p->n, *f->ptr, src, count, f->elem);
   }
+  /* new particles: new ids, in order from next_id (a copied id would be a duplicate) */
+  uint64_t *id = p->id;
+  const uint64_t id0 = p->next_id;
+  const long n0 = (long)p->n, nn = (long)count;
+  RHOD_KERNEL_LOOP
+  for (long k = 0; k < nn; k++)
+    id[n0 + k] = id0 + (uint64_t)k;
+  p->next_id += (uint64_t)count;
   p->n += count;
   p->ng = 0;
+}
+
+long rhod_particles_compact(rhod_particles *p, int32_t *keep, size_t nflag) {
+  const long n = (long)p->n, nf = (long)nflag;
+  if (nf > n)
+    return -1;
+  /* flags 0 or 1, and keep[nf] = 0 to close the scan: keep[i] becomes the new slot of
+   * a kept i < nf */
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i <= nf; i++)
+    keep[i] = i < nf && keep[i] != 0;
+  const long kept = rhod_scan_exclusive(keep, (size_t)nf + 1);
+  if (kept < 0)
+    return -1;
+  int32_t *perm = p->perm;
+  /* a kept particle's slot is where the scan steps up to the next (keep[i + 1] > keep[i]) */
+  RHOD_KERNEL_LOOP
+  for (long i = 0; i < nf; i++)
+    if (keep[i + 1] > keep[i])
+      perm[keep[i]] = (int32_t)i;
+  /* the particles after the flagged ones stay behind, in order */
+  RHOD_KERNEL_LOOP
+  for (long t = nf; t < n; t++)
+    perm[kept + t - nf] = (int32_t)t;
+  p->n = (size_t)(kept + n - nf);
+  p->ng = 0;
+  rhod_particles_permute(p);
+  return (long)p->n;
 }
 
 void rhod_particles_permute(rhod_particles *p) {

@@ -2,6 +2,7 @@
 #define _DEFAULT_SOURCE /* sysconf(_SC_PHYS_PAGES) */
 #include "rhod/sim.h"
 #include "rhod/kernel.h"
+#include "rhod/shepard.h"
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -620,35 +621,58 @@ unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MA
   return k;
 }
 
+/* The pressure probes are read PROBE_CHUNK points at a time. */
+#define PROBE_CHUNK 16
+
+/* Pressure at the nq points (px, py): Shepard interpolation (rhod_shepard, paper 000 Eq. 8)
+ * over fluid and ghosts from the cells of the prepared state; 0 where the support is dry
+ * (Gamma < 0.1). A point has no size of its own: each particle contributes with its own
+ * radius R_j (our choice; one size gives the usual sum). Into values[col[q]]. */
+static void pressure_probes(rhod_sim *s, int nq, real *px, real *py, const unsigned *col,
+                            double *values) {
+  if (nq == 0)
+    return;
+  const rhod_particles *p = &s->p;
+  real fp[PROBE_CHUNK], gm[PROBE_CHUNK];
+  const size_t bytes = (size_t)nq * sizeof(real);
+  rhod_dev_map(px, bytes);
+  rhod_dev_map(py, bytes);
+  rhod_dev_map(fp, bytes);
+  rhod_dev_map(gm, bytes);
+  rhod_shepard(&s->cells, s->sc->kernel, (real)s->sc->radius_ratio, p->x, p->y, p->dx, *s->V, *s->P,
+               nq, px, py, fp, gm);
+  rhod_to_host(fp, bytes);
+  rhod_to_host(gm, bytes);
+  rhod_dev_unmap(px, bytes);
+  rhod_dev_unmap(py, bytes);
+  rhod_dev_unmap(fp, bytes);
+  rhod_dev_unmap(gm, bytes);
+  for (int q = 0; q < nq; q++)
+    values[col[q]] = gm[q] > (real)0.1 ? (double)fp[q] : 0.0;
+}
+
 void rhod_probe_values(rhod_sim *s, double *values) {
   const rhod_scene *sc = s->sc;
   rhod_particles *p = &s->p;
-  const long n = (long)p->n, nt = (long)(p->n + p->ng);
-  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *m = p->m, *P = *s->P, *V = *s->V;
-  const int kern = sc->kernel;
-  const real *dx = p->dx, ratio = (real)sc->radius_ratio;
+  const long n = (long)p->n;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *m = p->m;
   const real gx = (real)sc->gravity[0], gy = (real)sc->gravity[1];
+  real px[PROBE_CHUNK], py[PROBE_CHUNK];
+  unsigned col[PROBE_CHUNK];
+  int nq = 0;
   unsigned k = 0;
   for (unsigned i = 0; i < sc->n_probes; i++) {
     const rhod_probe *pr = &sc->probes[i];
     const real ax = (real)pr->at[0], ay = (real)pr->at[1];
     const real dx_ = (real)pr->direction[0], dy_ = (real)pr->direction[1];
     switch (pr->kind) {
-    case RHOD_PROBE_PRESSURE: {
-      /* Shepard interpolation over fluid and ghosts; 0 where the support is dry
-       * (Gamma < 0.1). A point has no size of its own: each particle contributes
-       * with its own radius R_j (our choice; one size gives the usual sum). */
-      real num = 0, den = 0;
-      RHOD_KERNEL_LOOP_REDUCE2(+, num, den)
-      for (long j = 0; j < nt; j++) {
-        const real rx = x[j] - ax, ry = y[j] - ay;
-        const real w = rhod_W(kern, sqrt(rx * rx + ry * ry), ratio * dx[j]) * V[j];
-        num += w * P[j];
-        den += w;
+    case RHOD_PROBE_PRESSURE:
+      px[nq] = ax, py[nq] = ay, col[nq] = k++;
+      if (++nq == PROBE_CHUNK) {
+        pressure_probes(s, nq, px, py, col, values);
+        nq = 0;
       }
-      values[k++] = den > (real)0.1 ? (double)(num / den) : 0.0;
       break;
-    }
     case RHOD_PROBE_KINETIC_ENERGY: {
       real e = 0;
       RHOD_KERNEL_LOOP_REDUCE(+, e)
@@ -701,12 +725,16 @@ void rhod_probe_values(rhod_sim *s, double *values) {
       break;
     }
     default:
-      /* the scheme's own probes (rhod_sim_init refused those it has not) */
+      /* the scheme's own probes (rhod_sim_init refused those it has not), after the
+       * pressures before them (a scheme's probe may use the scheme's scratch) */
+      pressure_probes(s, nq, px, py, col, values);
+      nq = 0;
       s->ops->probe(s, pr, values + k);
       k += rhod_probe_ncolumns(pr->kind);
       break;
     }
   }
+  pressure_probes(s, nq, px, py, col, values);
 }
 
 void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {

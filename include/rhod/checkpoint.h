@@ -16,18 +16,24 @@
 #include <stdint.h>
 
 #define RHOD_CK_MAX_EXTRAS 16
+/* The fixed fields of versions 2 to 6, in their file order, as the reader names them among
+ * the extras: the APR totals (splits, merges: version 2; absorbed and the kinetic energy
+ * merges and absorptions took out: version 4) and the stiffness limit's measure (1/s,
+ * version 3). */
+#define RHOD_CK_LEGACY_EXTRAS 6
+extern const char *const rhod_ck_legacy_extra[RHOD_CK_LEGACY_EXTRAS];
 
 typedef struct {
   /* run state */
   double t, next_out, next_probe, next_checkpoint, checkpoint_every;
   int64_t step, reflected;
-  int64_t splits, merges;        /* APR totals of the run so far (0 from a version-1 file) */
-  double stiffness;              /* the stiffness limit's last measure, 1/s (0 before version 3) */
-  int64_t absorbed;              /* APR stragglers absorbed so far (0 before version 4) */
-  double ke_merged, ke_absorbed; /* the energy coalescing took out so far (idem) */
-  double picture_range[2];       /* the pictures' colour range, fixed at the first picture that
-                                    had one (version 5); NaN, NaN: none fixed yet */
-  int32_t nextra; /* the scheme's scalars (its ops->save and ops->load), by name (version 6) */
+  double picture_range[2]; /* the pictures' colour range, fixed at the first picture that
+                              had one (version 5); NaN, NaN: none fixed yet */
+  /* The scheme's scalars (its ops->save and ops->load), by name (version 6). Versions 2 to 6
+   * held RHOD-SPH's counters in fixed fields; the reader gives them as the extras RHOD-SPH
+   * saves since version 7 (RHOD_CK_LEGACY_EXTRAS, 0 where the version had none), after the
+   * file's own. */
+  int32_t nextra;
   char extra_name[RHOD_CK_MAX_EXTRAS][32];
   double extra[RHOD_CK_MAX_EXTRAS];
   uint64_t probes_bytes; /* length of probes.csv when the checkpoint was taken */

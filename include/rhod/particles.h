@@ -71,7 +71,15 @@ void rhod_particles_to_host(rhod_particles *p);
  * perm lives on the device (p->perm). */
 void rhod_particles_permute(rhod_particles *p);
 /* Appends `count` fluid particles, copies of src[k] (< n, on the device) in every
- * persistent array, at [n, n + count); the caller has reserved room and fixes what
- * differs (refinement children). Ghosts are dropped (p->ng = 0). */
+ * persistent array, at [n, n + count), with new ids: particle n + k gets next_id + k, and
+ * next_id grows by count. The caller has reserved room and fixes what differs
+ * (refinement children). Ghosts are dropped (p->ng = 0). */
 void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count);
+/* Removes fluid particles, keeping the order of the others in every persistent array
+ * (through p->perm and rhod_particles_permute): particle i < nflag stays where keep[i] is
+ * not 0, the particles at [nflag, n) all stay (e.g. those appended since the flags were
+ * set). keep: nflag + 1 int32 on the device, the flags at [0, nflag); overwritten (the
+ * new slots, an exclusive scan). Ghosts are dropped. Returns the new n, or -1 when out
+ * of memory (the scan's) or nflag > n, the store then unchanged. */
+long rhod_particles_compact(rhod_particles *p, int32_t *keep, size_t nflag);
 #endif

@@ -716,12 +716,11 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
     if (mark[i] == 1)
       for (int k = 0; k < extra; k++)
         src[cnt[i] + k] = (int32_t)i;
-  /* velocity (u_child = u_i, Sec. V A) and every other persistent array come along */
+  /* velocity (u_child = u_i, Sec. V A) and every other persistent array come along; the
+   * store gives the children at n + cnt[i] + k - 1 their new ids */
   rhod_particles_append(p, src, (size_t)added);
   real *x = p->x, *y = p->y, *rho = p->rho, *m = p->m, *dx = p->dx;
-  uint64_t *id = p->id;
   const real *sd = a->sd;
-  const uint64_t id0 = p->next_id;
   const real c2 = s->c0 * s->c0, ic2 = 1 / c2, rho0 = s->rho0;
   const real ieps = a->ieps, inn = 1 / (real)nsplit;
   const int tri = nsplit == 3;
@@ -759,11 +758,8 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
       rho[c] = rho0 + Pc * ic2;
       m[c] = inn * mi;
       dx[c] = dc;
-      if (k > 0)
-        id[c] = id0 + (uint64_t)(cnt[i] + k - 1);
     }
   }
-  p->next_id += (uint64_t)added;
   a->split_last = added / extra;
   a->split_total += added / extra;
   return added / extra;
@@ -782,9 +778,10 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
   int32_t *cnt = a->cnt;
   real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *rho = p->rho, *m = p->m, *dx = p->dx;
   const real dx_max = a->dx_max, ieps = a->ieps;
+  /* kept: all but the merged members (4) and the spent donors (5) */
   RHOD_KERNEL_LOOP
-  for (long i = 0; i <= nm; i++)
-    cnt[i] = i < nm && mark[i] != 4 && mark[i] != 5;
+  for (long i = 0; i < nm; i++)
+    cnt[i] = mark[i] != 4 && mark[i] != 5;
   /* The merged particle, in the leader's slot (our choice, docs/choices.md): mass
    * m = sum m_k; position and velocity the mass-weighted means (centre of mass and
    * momentum conserved, as in paper 004 Sec. 2.3); volume V = sum m_k / rho_k
@@ -822,19 +819,9 @@ long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p) {
       D *= ieps;
     dx[i] = lead ? D : dx[i];
   }
-  const long kept = rhod_scan_exclusive(cnt, (size_t)nm + 1);
-  int32_t *perm = p->perm;
-  RHOD_KERNEL_LOOP
-  for (long i = 0; i < nm; i++)
-    if (mark[i] != 4 && mark[i] != 5)
-      perm[cnt[i]] = (int32_t)i;
-  /* the children of this step's split stay behind, in order */
-  RHOD_KERNEL_LOOP
-  for (long t = nm; t < n; t++)
-    perm[kept + t - nm] = (int32_t)t;
-  p->n = (size_t)(kept + n - nm);
-  p->ng = 0;
-  rhod_particles_permute(p);
+  /* the children of this step's split, after nm, stay behind in order */
+  if (rhod_particles_compact(p, cnt, (size_t)nm) < 0)
+    return -1;
   a->merged_last = groups;
   a->merged_total += groups;
   a->absorbed_last = absorbed;

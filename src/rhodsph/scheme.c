@@ -263,7 +263,8 @@ static int rs_end_step(rhod_sim *s) {
     return RHOD_OK;
   if (rhod_apr_split(&rs->apr, &rs->sph, p, &s->bnd) < 0)
     return RHOD_ERR_MEMORY;
-  rhod_apr_coalesce(&rs->apr, p);
+  if (rhod_apr_coalesce(&rs->apr, p) < 0)
+    return RHOD_ERR_MEMORY;
   if (rs->apr.split_last > 0 || rs->apr.merged_last > 0 || rs->apr.absorbed_last > 0)
     s->dt = rhod_sph_dt(&rs->sph, p);
   return RHOD_OK;
@@ -382,25 +383,59 @@ static void rs_report(const rhod_sim *s, long steps, rhod_warn_buf *w) {
               rs->stiffness_limited, steps);
 }
 
+/* The scalars a resume needs, as the checkpoint's named extras: the APR totals the summary
+ * reports and the stiffness limit's last measure (1/s), which sets the next dt. The names
+ * are those the checkpoint reader gives the fixed fields of versions 2 to 6
+ * (rhod_ck_legacy_extra), so an older checkpoint resumes as before. */
+enum { RS_SPLITS, RS_MERGES, RS_STIFFNESS, RS_ABSORBED, RS_KE_MERGED, RS_KE_ABSORBED, RS_NEXTRA };
+_Static_assert(RS_NEXTRA == RHOD_CK_LEGACY_EXTRAS, "RHOD-SPH's extras are the legacy fields");
+
 static void rs_save(const rhod_sim *s, rhod_checkpoint *ck) {
   const rhod_rhodsph *rs = rhod_rs(s);
-  ck->splits = rs->apr.split_total;
-  ck->merges = rs->apr.merged_total;
-  ck->absorbed = rs->apr.absorbed_total;
-  ck->ke_merged = rs->apr.ke_merged;
-  ck->ke_absorbed = rs->apr.ke_absorbed;
-  ck->stiffness = rs->sph.st_lambda;
+  const double v[RS_NEXTRA] = {
+      [RS_SPLITS] = (double)rs->apr.split_total, [RS_MERGES] = (double)rs->apr.merged_total,
+      [RS_STIFFNESS] = rs->sph.st_lambda,        [RS_ABSORBED] = (double)rs->apr.absorbed_total,
+      [RS_KE_MERGED] = rs->apr.ke_merged,        [RS_KE_ABSORBED] = rs->apr.ke_absorbed};
+  ck->nextra = RS_NEXTRA;
+  for (int k = 0; k < RS_NEXTRA; k++) {
+    snprintf(ck->extra_name[k], sizeof ck->extra_name[k], "%s", rhod_ck_legacy_extra[k]);
+    ck->extra[k] = v[k];
+  }
 }
 
 static int rs_load(rhod_sim *s, const rhod_checkpoint *ck, char *err, size_t errlen) {
-  (void)err, (void)errlen;
   rhod_rhodsph *rs = rhod_rs(s);
-  rs->apr.split_total = ck->splits;
-  rs->apr.merged_total = ck->merges;
-  rs->apr.absorbed_total = ck->absorbed;
-  rs->apr.ke_merged = ck->ke_merged;
-  rs->apr.ke_absorbed = ck->ke_absorbed;
-  rs->sph.st_lambda = (real)ck->stiffness;
+  double v[RS_NEXTRA];
+  for (int k = 0; k < RS_NEXTRA; k++) {
+    const char *name = rhod_ck_legacy_extra[k];
+    int i = 0;
+    while (i < ck->nextra && strcmp(ck->extra_name[i], name))
+      i++;
+    if (i == ck->nextra) {
+      snprintf(err, errlen, "the checkpoint has no %s (not an rhodsph run's?)", name);
+      return RHOD_ERR_CHECKPOINT;
+    }
+    v[k] = ck->extra[i];
+    /* counts: whole numbers >= 0 (below 2^53, exact in a double); the stiffness finite and
+     * >= 0; the energies finite */
+    const int count = k == RS_SPLITS || k == RS_MERGES || k == RS_ABSORBED;
+    const int bad = count               ? !(v[k] >= 0 && v[k] < 0x1p53 && v[k] == floor(v[k]))
+                    : k == RS_STIFFNESS ? !(v[k] >= 0 && v[k] < HUGE_VAL)
+                                        : !isfinite(v[k]);
+    if (bad) {
+      snprintf(err, errlen, "the checkpoint's %s: %g, %s", name, v[k],
+               count               ? "must be a whole number >= 0"
+               : k == RS_STIFFNESS ? "must be finite and >= 0"
+                                   : "not a finite number");
+      return RHOD_ERR_CHECKPOINT;
+    }
+  }
+  rs->apr.split_total = (long)v[RS_SPLITS];
+  rs->apr.merged_total = (long)v[RS_MERGES];
+  rs->apr.absorbed_total = (long)v[RS_ABSORBED];
+  rs->apr.ke_merged = v[RS_KE_MERGED];
+  rs->apr.ke_absorbed = v[RS_KE_ABSORBED];
+  rs->sph.st_lambda = (real)v[RS_STIFFNESS];
   s->dt = rhod_sph_dt(&rs->sph, &s->p); /* sizes may have been split since t = 0 */
   return RHOD_OK;
 }

@@ -78,7 +78,8 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
 
 /* Merges the groups formed by the last rhod_apr_mark and the absorbed stragglers into
  * their receivers (call it after rhod_apr_split, whose children it keeps) and removes
- * the merged and absorbed particles; returns the number of groups merged. Ghosts and
+ * the merged and absorbed particles; returns the number of groups merged, or < 0 when
+ * memory ran out (the removal's scan; the merged particles are then left in place). Ghosts and
  * cells are stale after it. */
 long rhod_apr_coalesce(rhod_apr *a, rhod_particles *p);
 
