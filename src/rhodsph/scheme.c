@@ -318,6 +318,24 @@ static void rs_output(rhod_sim *s, rhod_snapshot_view *v) {
   v->fs = rs->sph.fs;
 }
 
+/* The fields output.fields may name: the volume (rhod_sph_fill_state above) and what
+ * pass A (paper 002 Eqs. 7, 14, 5, 29, U_char after Eq. 27, lambda) and the free-surface
+ * detection compute for the prepared state in rs_output (rhod_sim_fetch makes the
+ * neighbours fresh for them). Not the shifting velocity nor the region pass's fields: those
+ * need the region pass and dt, which the output does not run. */
+static const rhod_output_field rs_outputs[] = {
+    {"V", "Volumes", "m^2"},
+    {"gam", "ShepardGamma", "1"},
+    {"ggam", "ShepardGammaGradients", "1/m"},
+    {"gP", "PressureGradients", "Pa/m"},
+    {"D", "VelocityDivergences", "1/s"},
+    {"gC", "ConcentrationGradients", "1/m"},
+    {"uch", "CharacteristicVelocities", "m/s"},
+    {"lam", "SmallestEigenvalues", "1"},
+    {"nrm", "Normals", "1"},
+    {NULL, NULL, NULL},
+};
+
 static int rs_stats(const rhod_sim *s, rhod_stat *out, int max) {
   const rhod_rhodsph *rs = rhod_rs(s);
   const rhod_stat st[] = {
@@ -396,6 +414,7 @@ const rhod_scheme_ops rhod_rhodsph_ops = {
     .end_step = rs_end_step,
     .probe = rs_probe,
     .output = rs_output,
+    .outputs = rs_outputs,
     .stats = rs_stats,
     .report = rs_report,
     .save = rs_save,
