@@ -110,16 +110,10 @@ static int init_lattice(rhod_cells *c, const double lo[2], const double hi[2], d
 
 int rhod_cells_init(rhod_cells *c, const double lo[2], const double hi[2], double radius, int reach,
                     size_t cap) {
-  int st = init_lattice(c, lo, hi, radius, reach, cap);
-  if (st != RHOD_OK)
-    return st;
-  c->sub = malloc(sizeof *c->sub);
-  return c->sub ? init_lattice(c->sub, lo, hi, radius, reach, cap) : RHOD_ERR_MEMORY;
+  return init_lattice(c, lo, hi, radius, reach, cap);
 }
 
 int rhod_cells_reserve(rhod_cells *c, size_t cap) {
-  if (c->sub && rhod_cells_reserve(c->sub, cap) != RHOD_OK)
-    return RHOD_ERR_MEMORY;
   if (cap <= c->cap && c->idx)
     return RHOD_OK;
   map_free(&c->idx, c->cap);
@@ -131,11 +125,6 @@ int rhod_cells_reserve(rhod_cells *c, size_t cap) {
 }
 
 void rhod_cells_free(rhod_cells *c) {
-  if (c->sub) {
-    rhod_cells_free(c->sub);
-    free(c->sub);
-    c->sub = NULL;
-  }
   map_free(&c->start, c->ncells_box + 1);
   map_free(&c->count, c->ncells_box + 1);
   map_free(&c->idx, c->cap);
@@ -241,12 +230,32 @@ static long sort_counted(rhod_cells *c, const int32_t *key, const uint8_t *flag,
   return total;
 }
 
-long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag) {
-  rhod_cells *u = c->sub;
-  u->g = c->g, u->ncells = c->ncells; /* the window of the last build */
+/* Sizes a subset to `from`: start and count for from's whole box, idx for its capacity
+ * (the subset keeps no keys). */
+static int fit_subset(rhod_cells *u, const rhod_cells *from) {
+  if (!u->start || u->ncells_box < from->ncells_box) {
+    map_free(&u->start, u->ncells_box + 1);
+    map_free(&u->count, u->ncells_box + 1);
+    u->ncells_box = from->ncells_box;
+    map_alloc(&u->start, u->ncells_box + 1);
+    map_alloc(&u->count, u->ncells_box + 1);
+  }
+  if (!u->idx || u->cap < from->cap) {
+    map_free(&u->idx, u->cap);
+    u->cap = from->cap;
+    map_alloc(&u->idx, u->cap);
+  }
+  u->nx_box = from->nx_box, u->ny_box = from->ny_box;
+  return u->start && u->count && u->idx ? RHOD_OK : RHOD_ERR_MEMORY;
+}
+
+long rhod_cells_build_subset(rhod_cells *u, const rhod_cells *from, const uint8_t *flag) {
+  if (fit_subset(u, from) != RHOD_OK)
+    return -1;
+  u->g = from->g, u->ncells = from->ncells; /* the window of from's last build */
   int32_t *cnt = clear_counts(u);
-  const int32_t *key = c->key;
-  const long n = c->nbuilt;
+  const int32_t *key = from->key;
+  const long n = from->nbuilt;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     if (flag[i]) {
@@ -254,7 +263,7 @@ long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag) {
       cnt[key[i]] += 1;
     }
   }
-  return c->nsub = sort_counted(u, key, flag, n);
+  return u->nbuilt = sort_counted(u, key, flag, n);
 }
 
 void rhod_cells_pack(const rhod_cells *c, long nt, real *row, const real *src, int stride,

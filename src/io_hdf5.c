@@ -235,6 +235,24 @@ static int write_particles(h5_reason *R, hid_t file, const rhod_snapshot_view *v
     rc = write_dataset(R, g, "FreeSurface", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, v->fs, "1");
   if (!rc && v->phase)
     rc = write_dataset(R, g, "Phase", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, v->phase, "1");
+  /* the extra datasets (output.fields): reals as double, vectors N x 3 like Velocities */
+  for (unsigned k = 0; k < v->nextra && !rc; k++) {
+    const rhod_snapshot_extra *e = &v->extra[k];
+    if (e->u8) {
+      rc = write_dataset(R, g, e->name, H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, e->data, e->units);
+    } else if (e->comps == 2) {
+      const real *a = e->data;
+      for (size_t i = 0; i < n; i++) {
+        buf[3 * i] = (double)a[2 * i];
+        buf[3 * i + 1] = (double)a[2 * i + 1];
+        buf[3 * i + 2] = 0.0;
+      }
+      rc = write_dataset(R, g, e->name, F, M, n, 3, buf, e->units);
+    } else {
+      to_double(buf, e->data, n);
+      rc = write_dataset(R, g, e->name, F, M, n, 0, buf, e->units);
+    }
+  }
   return close_group(R, g, rc);
 }
 
@@ -401,6 +419,8 @@ static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_vie
   }
   /* one allocation of the core driver for the whole file, most of the time */
   size_t increment = n * (6 * sizeof(double) + 4 * sizeof(double) + 9 + 8) + (1u << 16);
+  for (unsigned k = 0; k < v->nextra; k++)
+    increment += n * (v->extra[k].u8 ? 1 : 3 * sizeof(double));
   hid_t file = core_file(R, name, increment);
   int bad = file < 0;
   if (!bad)
@@ -435,6 +455,22 @@ int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
     set_err(err, errlen, "%s: cannot write: a particle field is missing", path);
     free(path);
     return RHOD_ERR_IO;
+  }
+  if (v->nextra > RHOD_MAX_EXTRA_FIELDS) {
+    set_err(err, errlen, "%s: cannot write: %u extra fields, more than %d", path, v->nextra,
+            RHOD_MAX_EXTRA_FIELDS);
+    free(path);
+    return RHOD_ERR_IO;
+  }
+  for (unsigned k = 0; k < v->nextra; k++) {
+    const rhod_snapshot_extra *e = &v->extra[k];
+    if (!e->name || !e->name[0] || !e->units || (v->n > 0 && !e->data) ||
+        !(e->comps == 1 || (e->comps == 2 && !e->u8))) {
+      set_err(err, errlen, "%s: cannot write: extra field %u (%s) is incomplete", path, k,
+              e->name ? e->name : "no name");
+      free(path);
+      return RHOD_ERR_IO;
+    }
   }
   h5_quiet();
   h5_reason R = {0, 0, 0, ""};
@@ -918,6 +954,149 @@ static int read_params(reader *r, rhod_param_list *out) {
   return rc;
 }
 
+/* The datasets rhod_write_snapshot writes itself; every other one of /PartType0 is an
+ * extra. */
+static int fixed_dataset(const char *name) {
+  static const char *const fixed[] = {"Coordinates", "Velocities",  "Densities",
+                                      "Pressures",   "Masses",      "ParticleSizes",
+                                      "ParticleIDs", "FreeSurface", "Phase"};
+  for (size_t k = 0; k < sizeof fixed / sizeof fixed[0]; k++)
+    if (!strcmp(name, fixed[k]))
+      return 1;
+  return 0;
+}
+
+typedef struct {
+  char **names;
+  unsigned n, cap;
+  int oom;
+} name_list;
+
+static herr_t extra_name_cb(hid_t g, const char *name, const H5L_info_t *info, void *data) {
+  (void)g, (void)info;
+  name_list *l = data;
+  if (fixed_dataset(name))
+    return 0;
+  if (l->n == l->cap) {
+    unsigned cap = l->cap ? 2 * l->cap : 8;
+    char **a = realloc(l->names, cap * sizeof *a);
+    if (!a) {
+      l->oom = 1;
+      return -1;
+    }
+    l->names = a, l->cap = cap;
+  }
+  if (!(l->names[l->n] = strdup(name))) {
+    l->oom = 1;
+    return -1;
+  }
+  l->n++;
+  return 0;
+}
+
+/* One extra dataset: uint8 of N, or float of N or N x 3 (a vector, z dropped), with a
+ * string attribute Units. */
+static int read_extra(reader *r, size_t n, rhod_snapshot_extra_data *e) {
+  char full[96];
+  snprintf(full, sizeof full, "/PartType0/%s", e->name);
+  hid_t d = H5Dopen2(r->file, full, H5P_DEFAULT);
+  if (d < 0)
+    return rfail(r, full);
+  hid_t sp = H5Dget_space(d), ft = H5Dget_type(d);
+  hsize_t dims[3] = {0, 0, 0};
+  const int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+  if (rank >= 1 && rank <= 2)
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+  const H5T_class_t cl = ft >= 0 ? H5Tget_class(ft) : H5T_NO_CLASS;
+  const int u8 = cl == H5T_INTEGER && H5Tget_size(ft) == 1 && H5Tget_sign(ft) == H5T_SGN_NONE;
+  int rc = RHOD_OK;
+  if (!(dims[0] == (hsize_t)n && (rank == 1 || (rank == 2 && dims[1] == 3 && cl == H5T_FLOAT)) &&
+        (u8 || cl == H5T_FLOAT))) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen,
+            "%s: dataset %s is neither N uint8 nor N or N x 3 floating-point values (N = %zu)",
+            r->path, full, n);
+    rc = RHOD_ERR_READ;
+  }
+  e->u8 = u8;
+  e->comps = rank == 2 ? 2 : 1;
+  const size_t nn = n ? n : 1;
+  double *buf = NULL;
+  if (!rc) {
+    if (u8)
+      e->b = malloc(nn);
+    else
+      e->v = malloc(nn * (size_t)e->comps * sizeof(double));
+    buf = rank == 2 ? malloc(3 * nn * sizeof *buf) : NULL;
+    if ((u8 ? !e->b : !e->v) || (rank == 2 && !buf)) {
+      set_err(r->err, r->errlen, "%s: out of memory reading %s", r->path, full);
+      rc = RHOD_ERR_MEMORY;
+    }
+  }
+  if (!rc && n > 0) {
+    void *to = u8 ? (void *)e->b : rank == 2 ? (void *)buf : (void *)e->v;
+    if (H5Dread(d, u8 ? H5T_NATIVE_UINT8 : H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, to) <
+        0)
+      rc = rfail(r, full);
+  }
+  for (size_t i = 0; !rc && buf && i < n; i++)
+    e->v[2 * i] = buf[3 * i], e->v[2 * i + 1] = buf[3 * i + 1];
+  free(buf);
+  if (!rc) {
+    hid_t a = H5Aexists(d, "Units") > 0 ? H5Aopen(d, "Units", H5P_DEFAULT) : -1;
+    e->units = a >= 0 ? read_string_attr(a) : NULL;
+    if (a >= 0)
+      H5Aclose(a);
+    if (!e->units) {
+      H5Eclear2(H5E_DEFAULT);
+      set_err(r->err, r->errlen, "%s: dataset %s has no string attribute Units", r->path, full);
+      rc = RHOD_ERR_READ;
+    }
+  }
+  if (ft >= 0)
+    H5Tclose(ft);
+  if (sp >= 0)
+    H5Sclose(sp);
+  H5Dclose(d);
+  return rc;
+}
+
+/* Every dataset of /PartType0 that is not a fixed one, in name order. */
+static int read_extras(reader *r, rhod_snapshot_data *out) {
+  hid_t g = H5Gopen2(r->file, "/PartType0", H5P_DEFAULT);
+  if (g < 0)
+    return rfail(r, "/PartType0");
+  name_list l = {NULL, 0, 0, 0};
+  hsize_t at = 0;
+  const herr_t it = H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, &at, extra_name_cb, &l);
+  int rc = RHOD_OK;
+  if (l.oom) {
+    set_err(r->err, r->errlen, "%s: out of memory reading /PartType0", r->path);
+    rc = RHOD_ERR_MEMORY;
+  } else if (it < 0) {
+    rc = rfail(r, "/PartType0");
+  }
+  H5Gclose(g);
+  if (!rc && l.n) {
+    out->extra = calloc(l.n, sizeof *out->extra);
+    if (!out->extra) {
+      set_err(r->err, r->errlen, "%s: out of memory reading /PartType0", r->path);
+      rc = RHOD_ERR_MEMORY;
+    }
+  }
+  for (unsigned k = 0; k < l.n; k++) {
+    if (!rc) {
+      out->extra[k].name = l.names[k];
+      out->nextra = k + 1;
+      rc = read_extra(r, out->n, &out->extra[k]);
+    } else {
+      free(l.names[k]);
+    }
+  }
+  free(l.names);
+  return rc;
+}
+
 static int read_all(reader *r, rhod_snapshot_data *out) {
   if (H5Lexists(r->file, "/Header", H5P_DEFAULT) <= 0) {
     H5Eclear2(H5E_DEFAULT);
@@ -995,6 +1174,8 @@ static int read_all(reader *r, rhod_snapshot_data *out) {
   }
   H5Eclear2(H5E_DEFAULT);
   if (!rc)
+    rc = read_extras(r, out);
+  if (!rc)
     rc = read_params(r, &out->params);
   return rc;
 }
@@ -1055,6 +1236,13 @@ void rhod_snapshot_data_free(rhod_snapshot_data *d) {
   free(d->id);
   free(d->fs);
   free(d->phase);
+  for (unsigned i = 0; i < d->nextra; i++) {
+    free(d->extra[i].name);
+    free(d->extra[i].units);
+    free(d->extra[i].v);
+    free(d->extra[i].b);
+  }
+  free(d->extra);
   for (unsigned i = 0; i < d->params.n; i++) {
     free(d->params.keys[i]);
     free(d->params.values[i]);

@@ -41,7 +41,8 @@ static void attribute(FILE *f, const char *file, const char *name, const char *d
   fprintf(f, "        </Attribute>\n");
 }
 
-static void grid(FILE *f, int index, double time, size_t n, unsigned fields) {
+static void grid(FILE *f, int index, double time, size_t n, unsigned fields,
+                 const rhod_snapshot_extra *extra, unsigned nextra) {
   char file[64];
   snprintf(file, sizeof file, "snapshot_%04d.h5", index);
   fprintf(f, "      <Grid Name=\"snapshot_%04d\" GridType=\"Uniform\">\n", index);
@@ -66,11 +67,23 @@ static void grid(FILE *f, int index, double time, size_t n, unsigned fields) {
     attribute(f, file, "FreeSurface", "/PartType0/FreeSurface", n, 0, "UChar", 1);
   if (fields & RHOD_FIELDS_PHASE)
     attribute(f, file, "Phase", "/PartType0/Phase", n, 0, "UChar", 1);
+  for (unsigned k = 0; k < nextra; k++) { /* output.fields: named as their datasets */
+    char ds[96];
+    snprintf(ds, sizeof ds, "/PartType0/%s", extra[k].name);
+    attribute(f, file, extra[k].name, ds, n, extra[k].comps == 2, extra[k].u8 ? "UChar" : "Float",
+              extra[k].u8 ? 1 : 8);
+  }
   fprintf(f, "      </Grid>\n");
 }
 
 int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
                     unsigned fields, char *err, size_t errlen) {
+  return rhod_write_xdmf_fields(dir, count, times, nparts, fields, NULL, 0, err, errlen);
+}
+
+int rhod_write_xdmf_fields(const char *dir, int count, const double *times, const size_t *nparts,
+                           unsigned fields, const rhod_snapshot_extra *extra, unsigned nextra,
+                           char *err, size_t errlen) {
   size_t dl = dir ? strlen(dir) : 0;
   const char *name = "snapshots.xdmf";
   char *path = malloc(dl + strlen(name) + 2);
@@ -100,7 +113,7 @@ int rhod_write_xdmf(const char *dir, int count, const double *times, const size_
              "    <Grid Name=\"particles\" GridType=\"Collection\" "
              "CollectionType=\"Temporal\">\n");
   for (int i = 0; i < count; i++)
-    grid(f, i, times[i], nparts[i], fields);
+    grid(f, i, times[i], nparts[i], fields, extra, nextra);
   fprintf(f, "    </Grid>\n"
              "  </Domain>\n"
              "</Xdmf>\n");

@@ -409,8 +409,12 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
 static int write_output(run_ctx *c, char *err, size_t len) {
   rhod_sim *s = &c->sim;
   rhod_snapshot_view v;
-  rhod_sim_fetch(s, &v);
-  int st = rhod_snapshot_check(&v, err, len);
+  int st = rhod_sim_fetch(s, &v);
+  if (st != RHOD_OK) {
+    snprintf(err, len, "out of memory for ghost particles");
+    return st;
+  }
+  st = rhod_snapshot_check(&v, err, len);
   if (st != RHOD_OK)
     return st;
   st = rhod_write_snapshot(c->out, c->nsnap, &v, &c->params, err, len);
@@ -426,7 +430,8 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   c->snap_t[c->nsnap] = s->t;
   c->snap_n[c->nsnap] = s->p.n;
   c->nsnap++;
-  st = rhod_write_xdmf(c->out, c->nsnap, c->snap_t, c->snap_n, rhod_snapshot_fields(&v), err, len);
+  st = rhod_write_xdmf_fields(c->out, c->nsnap, c->snap_t, c->snap_n, rhod_snapshot_fields(&v),
+                              v.extra, v.nextra, err, len);
   if (st != RHOD_OK)
     return st;
   const rhod_scene *sc = c->sc;

@@ -18,6 +18,7 @@
 #include "scene_module.h"
 #include "scene_yaml.h"
 
+#include <ctype.h>
 #include <cyaml/cyaml.h>
 #include <errno.h>
 #include <math.h>
@@ -158,6 +159,8 @@ typedef struct {
 
 typedef struct {
   y_picture *picture;
+  char **fields;
+  unsigned n_fields;
 } y_output;
 
 typedef struct {
@@ -399,8 +402,13 @@ static const cyaml_schema_field_t f_picture[] = {
     CYAML_FIELD_END,
 };
 
+static const cyaml_schema_value_t sch_output_field = {
+    CYAML_VALUE_STRING(CYAML_FLAG_POINTER, char, 1, NAME_MAX_LEN)};
+
 static const cyaml_schema_field_t f_output[] = {
     CYAML_FIELD_MAPPING_PTR("picture", OPT, y_output, picture, f_picture),
+    CYAML_FIELD_SEQUENCE_COUNT("fields", OPT, y_output, fields, n_fields, &sch_output_field, 0,
+                               RHOD_MAX_OUTPUT_FIELDS),
     CYAML_FIELD_END,
 };
 
@@ -1866,6 +1874,28 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
           s->picture_box_min[1] < s->picture_box_max[1]))
       return fail(c, "output.picture.box.max", "must exceed output.picture.box.min in both axes");
   }
+  /* output.fields: identifiers, each once (which the run has: rhod_sim_init) */
+  const unsigned nof = d->output ? d->output->n_fields : 0;
+  if (nof) {
+    s->output_fields = calloc(nof, sizeof *s->output_fields);
+    if (!s->output_fields)
+      return fail_oom(c);
+  }
+  for (unsigned i = 0; i < nof; i++) {
+    const char *f = d->output->fields[i];
+    char key[48];
+    snprintf(key, sizeof key, "output.fields.%u", i);
+    if (!(isalpha((unsigned char)f[0]) || f[0] == '_') ||
+        strspn(f, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != strlen(f))
+      return fail(c, key, "'%s' is not a field name (a letter or '_', then letters, digits, '_')",
+                  f);
+    for (unsigned j = 0; j < i; j++)
+      if (!strcmp(f, s->output_fields[j]))
+        return fail(c, key, "'%s' is named twice (also output.fields.%u)", f, j);
+    if (!(s->output_fields[i] = strdup(f)))
+      return fail_oom(c);
+    s->n_output_fields = i + 1;
+  }
   TRY(check_limits(c, s));
   /* name */
   if (d->name) {
@@ -2138,6 +2168,11 @@ static ry_node *scene_tree(const rhod_scene *s) {
   if (rs)
     rhod_rs_tree_refinement(&t, root, rs);
   m = tb_coll(&t, root, "output", RY_MAP, 0);
+  if (s->n_output_fields) { /* written when given (none: the key is left out) */
+    e = tb_coll(&t, m, "fields", RY_SEQ, 1);
+    for (unsigned i = 0; i < s->n_output_fields; i++)
+      tb_word(&t, e, NULL, s->output_fields[i]);
+  }
   if (!s->picture_enabled) {
     tb_bool(&t, m, "picture", 0);
     goto done;
@@ -2178,6 +2213,9 @@ void rhod_scene_free(rhod_scene *s) {
   free(s->fluid);
   free(s->walls);
   free(s->probes);
+  for (unsigned i = 0; i < s->n_output_fields; i++)
+    free(s->output_fields[i]);
+  free(s->output_fields);
   free(s->name);
   free(s->path);
   free(s->yaml);

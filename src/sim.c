@@ -346,6 +346,63 @@ static int engine_probe(rhod_probe_kind kind) {
   return kind != RHOD_PROBE_ELASTIC_ENERGY && kind != RHOD_PROBE_TORQUE_BUDGET;
 }
 
+/* ---- output.fields ------------------------------------------------------------------------ */
+
+/* The engine's own fields output.fields may name: the persistent tags (where a scheme has
+ * them; the phase is written as Phase already). */
+static const rhod_output_field engine_outputs[] = {
+    {"level", "Level", "1"},
+    {"kind", "Kind", "1"},
+    {NULL, NULL, NULL},
+};
+
+/* The store's entry for a field output.fields may name: in the engine's or the scheme's
+ * list, registered in this run, and of a type a snapshot holds (uint8, 1 or 2 reals);
+ * *d its description, *scheme 1 when it is the scheme's. NULL when there is none. */
+static const rhod_field_desc *output_field(const rhod_sim *s, const char *name,
+                                           const rhod_output_field **d, int *scheme) {
+  const rhod_output_field *lists[2] = {engine_outputs, s->ops->outputs};
+  for (int l = 0; l < 2; l++)
+    for (const rhod_output_field *o = lists[l]; o && o->field; o++) {
+      if (strcmp(o->field, name) != 0)
+        continue;
+      for (int k = 0; k < s->p.nfields; k++) {
+        const rhod_field_desc *f = &s->p.fields[k];
+        const size_t e = f->elem;
+        if (strcmp(f->name, name) == 0 && (e == 1 || e == sizeof(real) || e == 2 * sizeof(real))) {
+          *d = o;
+          *scheme = l;
+          return f;
+        }
+      }
+    }
+  return NULL;
+}
+
+/* Every name of output.fields must be a field this run can write: else the message names
+ * the key, the name and those it has. */
+static int check_output_fields(const rhod_sim *s, char *err, size_t errlen) {
+  const rhod_scene *sc = s->sc;
+  for (unsigned i = 0; i < sc->n_output_fields; i++) {
+    const rhod_output_field *d;
+    int scheme;
+    if (output_field(s, sc->output_fields[i], &d, &scheme))
+      continue;
+    char have[512] = "";
+    size_t at = 0;
+    const rhod_output_field *lists[2] = {engine_outputs, s->ops->outputs};
+    for (int l = 0; l < 2; l++)
+      for (const rhod_output_field *o = lists[l]; o && o->field; o++)
+        if (output_field(s, o->field, &d, &scheme) && at < sizeof have)
+          at += (size_t)snprintf(have + at, sizeof have - at, "%s%s", at ? ", " : "", o->field);
+    snprintf(err, errlen,
+             "%s: output.fields.%u: no field '%s' to write with scheme %s; available: %s", sc->path,
+             i, sc->output_fields[i], s->ops->name, at ? have : "none");
+    return RHOD_ERR_SCENE;
+  }
+  return RHOD_OK;
+}
+
 int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   memset(s, 0, sizeof *s);
   s->sc = sc;
@@ -423,6 +480,10 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
                sc->path, i, sc->probes[i].name, s->ops->name);
       return RHOD_ERR_SCENE;
     }
+  /* the fields output.fields names must be the run's */
+  st = check_output_fields(s, err, errlen);
+  if (st != RHOD_OK)
+    return st;
   /* host-side fill happens before anything is sent to the device */
   st = fill_fluid(s, err, errlen);
   if (st != RHOD_OK)
@@ -737,11 +798,30 @@ void rhod_probe_values(rhod_sim *s, double *values) {
   pressure_probes(s, nq, px, py, col, values);
 }
 
-void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
+int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
   rhod_particles *p = &s->p;
-  const size_t n = p->n;
+  const rhod_scene *sc = s->sc;
   *v = (rhod_snapshot_view){0};
+  /* a field of the scheme's among output.fields: the scheme computes it for this state,
+   * which needs the ghosts and cells of the current positions. After a step they are
+   * built again here, unsorted, and marked stale again, so that the next step sorts and
+   * builds them as it would have: the run goes on bit for bit as without the fields. */
+  int refresh = 0;
+  for (unsigned i = 0; i < sc->n_output_fields && !s->neighbours_fresh; i++) {
+    const rhod_output_field *d;
+    int scheme = 0;
+    output_field(s, sc->output_fields[i], &d, &scheme);
+    refresh |= scheme;
+  }
+  if (refresh) {
+    const int st = rhod_sim_prepare(s, 0);
+    if (st != RHOD_OK)
+      return st;
+  }
   s->ops->output(s, v); /* the scheme's fields (pressure, free surface ...) */
+  if (refresh)
+    s->neighbours_fresh = 0;
+  const size_t n = p->n;
   real *const f[7] = {p->x, p->y, p->ux, p->uy, p->rho, p->m, p->dx};
   for (int k = 0; k < 7; k++)
     rhod_to_host(f[k], n * sizeof(real));
@@ -754,6 +834,24 @@ void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
     rhod_to_host(p->phase, n);
     v->phase = p->phase;
   }
+  /* output.fields, in the scene's order (rhod_sim_init checked the names) */
+  for (unsigned i = 0; i < sc->n_output_fields && v->nextra < RHOD_MAX_EXTRA_FIELDS; i++) {
+    const rhod_output_field *d;
+    int scheme;
+    const rhod_field_desc *fd = output_field(s, sc->output_fields[i], &d, &scheme);
+    if (!fd)
+      continue;
+    void *data = *fd->ptr;
+    rhod_to_host(data, n * fd->elem);
+    v->extra[v->nextra++] = (rhod_snapshot_extra){
+        .name = d->dataset,
+        .units = d->units,
+        .data = data,
+        .u8 = fd->elem == 1,
+        .comps = fd->elem == 2 * sizeof(real) ? 2 : 1,
+    };
+  }
+  return RHOD_OK;
 }
 
 /* ---- warnings about the particles as set up -------------------------------------------- */

@@ -389,6 +389,92 @@ static void test_xdmf(void) {
   CU_ASSERT_PTR_NOT_NULL(strstr(err, "no_such_dir/snapshots.xdmf: cannot write"));
 }
 
+/* ------------------------------------------------------------ extra fields */
+
+/* The view's extra datasets (output.fields): a real scalar, a real vector and a uint8 flag
+ * written under /PartType0 with their units and read back as the generic list (name
+ * order), beside the fixed fields; the XDMF lists each as a node attribute. */
+static void test_extra_fields(void) {
+  const size_t n = 5;
+  particles P = make_particles(n);
+  rhod_snapshot_view v = view_of(&P, 0.75);
+  real gam[5], nrm[10];
+  uint8_t lev[5];
+  for (size_t i = 0; i < n; i++) { /* exact in float too */
+    gam[i] = (real)(1 - 0.125 * (double)i);
+    nrm[2 * i] = (real)(0.5 * (double)i), nrm[2 * i + 1] = (real)(-0.25 * (double)i);
+    lev[i] = (uint8_t)(3 * i);
+  }
+  v.nextra = 3;
+  v.extra[0] = (rhod_snapshot_extra){"ShepardGamma", "1", gam, 0, 1};
+  v.extra[1] = (rhod_snapshot_extra){"Normals", "1", nrm, 0, 2};
+  v.extra[2] = (rhod_snapshot_extra){"Level", "1", lev, 1, 1};
+  char err[512] = "";
+  CU_ASSERT_EQUAL_FATAL(rhod_write_snapshot(scratch, 40, &v, NULL, err, sizeof err), RHOD_OK);
+  hid_t file = H5Fopen(spath("snapshot_0040.h5"), H5F_ACC_RDONLY, H5P_DEFAULT);
+  CU_ASSERT_FATAL(file >= 0);
+  check_dataset_layout(file, "/PartType0/ShepardGamma", H5T_IEEE_F64LE, 1, n, 0);
+  check_dataset_layout(file, "/PartType0/Normals", H5T_IEEE_F64LE, 2, n, 3);
+  check_dataset_layout(file, "/PartType0/Level", H5T_STD_U8LE, 1, n, 0);
+  H5Fclose(file);
+  rhod_snapshot_data d;
+  CU_ASSERT_EQUAL_FATAL(rhod_read_snapshot(spath("snapshot_0040.h5"), &d, err, sizeof err),
+                        RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(d.nextra, 3);
+  /* name order: Level, Normals, ShepardGamma */
+  const rhod_snapshot_extra_data *L = &d.extra[0], *N = &d.extra[1], *G = &d.extra[2];
+  CU_ASSERT_STRING_EQUAL(L->name, "Level");
+  CU_ASSERT_STRING_EQUAL(N->name, "Normals");
+  CU_ASSERT_STRING_EQUAL(G->name, "ShepardGamma");
+  CU_ASSERT(L->u8 == 1 && L->comps == 1 && L->b && !L->v);
+  CU_ASSERT(N->u8 == 0 && N->comps == 2 && N->v && !N->b);
+  CU_ASSERT(G->u8 == 0 && G->comps == 1 && G->v && !G->b);
+  CU_ASSERT_STRING_EQUAL(G->units, "1");
+  int bad = 0;
+  for (size_t i = 0; i < n && L->b && N->v && G->v; i++)
+    bad += L->b[i] != lev[i] || N->v[2 * i] != (double)nrm[2 * i] ||
+           N->v[2 * i + 1] != (double)nrm[2 * i + 1] || G->v[i] != (double)gam[i] ||
+           d.x[i] != (double)P.x[i];
+  CU_ASSERT_EQUAL(bad, 0);
+  rhod_snapshot_data_free(&d);
+  /* a file without extras reads none; one with units on a vector of reals */
+  v.nextra = 0;
+  CU_ASSERT_EQUAL_FATAL(rhod_write_snapshot(scratch, 41, &v, NULL, err, sizeof err), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_read_snapshot(spath("snapshot_0041.h5"), &d, err, sizeof err),
+                        RHOD_OK);
+  CU_ASSERT_EQUAL(d.nextra, 0);
+  CU_ASSERT_PTR_NULL(d.extra);
+  rhod_snapshot_data_free(&d);
+  /* refused: a uint8 vector, a missing array */
+  v.nextra = 1;
+  v.extra[0] = (rhod_snapshot_extra){"Level", "1", lev, 1, 2};
+  CU_ASSERT_EQUAL(rhod_write_snapshot(scratch, 42, &v, NULL, err, sizeof err), RHOD_ERR_IO);
+  CU_ASSERT_PTR_NOT_NULL(strstr(err, "extra field 0 (Level) is incomplete"));
+  v.extra[0] = (rhod_snapshot_extra){"Level", "1", NULL, 1, 1};
+  CU_ASSERT_EQUAL(rhod_write_snapshot(scratch, 42, &v, NULL, err, sizeof err), RHOD_ERR_IO);
+  CU_ASSERT(!exists(spath("snapshot_0042.h5")));
+  /* the XDMF: one attribute per extra and snapshot, pointing at the dataset */
+  v.nextra = 3;
+  v.extra[0] = (rhod_snapshot_extra){"ShepardGamma", "1", gam, 0, 1};
+  double times[2] = {0, 0.75};
+  size_t np[2] = {n, n};
+  CU_ASSERT_EQUAL_FATAL(
+      rhod_write_xdmf_fields(scratch, 2, times, np, 0, v.extra, v.nextra, err, sizeof err),
+      RHOD_OK);
+  char *x = slurp(spath("snapshots.xdmf"), NULL);
+  CU_ASSERT_PTR_NOT_NULL_FATAL(x);
+  CU_ASSERT_EQUAL(count_of(x, "<Attribute "), 2 * (6 + 3));
+  CU_ASSERT_EQUAL(count_of(x, "Name=\"Normals\" AttributeType=\"Vector\""), 2);
+  CU_ASSERT_EQUAL(count_of(x, "Name=\"ShepardGamma\" AttributeType=\"Scalar\""), 2);
+  CU_ASSERT_EQUAL(count_of(x, "Name=\"Level\" AttributeType=\"Scalar\""), 2);
+  CU_ASSERT_PTR_NOT_NULL(strstr(x, "Dimensions=\"5 3\" NumberType=\"Float\" Precision=\"8\" "
+                                   "Format=\"HDF\">snapshot_0001.h5:/PartType0/Normals<"));
+  CU_ASSERT_PTR_NOT_NULL(strstr(x, "Dimensions=\"5\" NumberType=\"UChar\" Precision=\"1\" "
+                                   "Format=\"HDF\">snapshot_0000.h5:/PartType0/Level<"));
+  free(x);
+  free_particles(&P);
+}
+
 /* ------------------------------------------------------------ PNG */
 
 static int pixel_is(const rgb_image *im, unsigned x, unsigned y, int r, int g, int b) {
@@ -735,6 +821,7 @@ int main(void) {
       {"snapshot errors", test_snapshot_errors},
       {"snapshot write failing half way", test_snapshot_write_failure},
       {"xdmf sidecar", test_xdmf},
+      {"extra fields: round trip and xdmf", test_extra_fields},
       {"png picture", test_picture},
       {"png picture speed", test_picture_speed},
       {"atomic file writes", test_atomic_write},

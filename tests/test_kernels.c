@@ -104,6 +104,7 @@ static void cloud_rhs(cloud *cl) {
 }
 
 static void cloud_free(cloud *cl) {
+  rhod_sph_free(&cl->s);
   rhod_cells_free(&cl->c);
   rhod_particles_free(&cl->p);
   free(cl->sc);
@@ -683,6 +684,7 @@ static void bj_patch(int sw, bj_run *o) {
       o->jM[3 * i + k] = bal ? s.jM[3 * i + k] : 0;
     o->jmp[i] = bal ? s.jmp[i] : 0;
   }
+  rhod_sph_free(&s);
   rhod_cells_free(&c);
   rhod_particles_free(&p);
   free(sc);

@@ -47,12 +47,7 @@ typedef struct rhod_cells {
   int32_t *idx;       /* cap: particle indices sorted by cell */
   int32_t *key;       /* cap: cell of each particle */
   size_t cap;
-  long nbuilt; /* particles sorted by the last build */
-  /* The flagged particles of the last build alone, in the same cells and window
-   * (rhod_cells_build_subset): its start counts them cell by cell, its idx lists them
-   * (indices of the particles of the build). Allocated with the grid; none in a subset. */
-  struct rhod_cells *sub;
-  long nsub; /* particles in the subset */
+  long nbuilt; /* particles sorted by the last build (of a subset: the flagged ones) */
 } rhod_cells;
 
 /* Sets up a grid over [lo, hi] for kernel radii of at least `radius` (R0), with cells
@@ -67,11 +62,17 @@ void rhod_cells_free(rhod_cells *c);
  * still scans every particle within reach of it. */
 void rhod_cells_build(rhod_cells *c, const real *x, const real *y, size_t count);
 
-/* Sorts the particles of the last build with flag != 0 into c->sub (the same cells,
- * in index order inside each); returns how many (c->nsub). A gather over the subset
- * scans c->sub's rows, which hold only flagged particles, and a range of a row is
- * tested for any with two reads of its start (rhod_cells_near_any). */
-long rhod_cells_build_subset(rhod_cells *c, const uint8_t *flag);
+/* A subset: the particles of `from`'s last build with flag != 0 (flag on the device,
+ * one per particle of that build), sorted into the same cells and window as in `from`,
+ * in index order inside each; returns how many (sub->nbuilt), or -1 when out of memory.
+ * Its idx lists indices of the particles of from's build. The caller owns the subset,
+ * one per particle set (free surface, size jumps ...): a zeroed rhod_cells the first
+ * time, which this sizes to `from` (and resizes when from's box or capacity grows), freed
+ * with rhod_cells_free; it holds no keys of its own (it reads from's) and is not built
+ * with rhod_cells_build. A gather over the subset scans its rows, which hold only
+ * flagged particles, and a range of a row is tested for any with two reads of its start
+ * (rhod_cells_near_any). */
+long rhod_cells_build_subset(rhod_cells *sub, const rhod_cells *from, const uint8_t *flag);
 
 /* Cell coordinate of a position along one axis in the window [off, off + n) of the
  * lattice with origin o, relative to the window, clamped to it. */
@@ -220,7 +221,8 @@ static inline real rhod_lanes_min_(const real *s) {
 
 /* 1 when a cell within reach of a support of radius R at (x, y) holds a particle, for
  * the cell starts CS of a grid G (inside device regions: pass local copies; the
- * subset's, c->sub, for "a flagged particle in reach"): two reads per row. */
+ * subset's (rhod_cells_build_subset), for "a flagged particle in reach"): two reads per
+ * row. */
 static inline int rhod_cells_near_any_(const int32_t *CS, real ox, real oy, real inv, int cx0,
                                        int cy0, int nx, int ny, int rc, real x, real y) {
   const int cx = rhod_cell_coord(x, ox, inv, cx0, nx);

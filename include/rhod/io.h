@@ -10,6 +10,18 @@
 #include <stdint.h>
 #include <stdio.h>
 
+/* A dataset beyond the fixed ones (the scene's output.fields): /PartType0/<name> with a
+ * Units attribute, and the XDMF node attribute of the same name. */
+#define RHOD_MAX_EXTRA_FIELDS RHOD_MAX_OUTPUT_FIELDS
+typedef struct {
+  const char *name;  /* dataset name: letters, digits and '_', not one of the fixed ones */
+  const char *units; /* its Units attribute ("1" for a number) */
+  const void *data;  /* n * comps values of the particles, host copies: real, or uint8 */
+  int u8;            /* 1: uint8 values (comps 1), written as such; 0: real, as double */
+  int comps;         /* 1: N values; 2: a vector (x, y interleaved), written N x 3 with
+                        z = 0 like Velocities */
+} rhod_snapshot_extra;
+
 /* Host copies of the fluid particle fields for one output time. */
 typedef struct {
   double time;
@@ -23,6 +35,8 @@ typedef struct {
   const uint64_t *id;   /* persistent particle id */
   const uint8_t *fs;    /* free-surface flag (1: in F), may be NULL */
   const uint8_t *phase; /* phase index (the scene's phases, in order), may be NULL */
+  unsigned nextra;      /* the extra datasets, in this order */
+  rhod_snapshot_extra extra[RHOD_MAX_EXTRA_FIELDS];
 } rhod_snapshot_view;
 
 /* Checks every value of v before it is written: positions, velocities and pressures
@@ -38,7 +52,9 @@ int rhod_snapshot_check(const rhod_snapshot_view *v, char *err, size_t errlen);
  * (dense storage, creation order tracked). Plain contiguous datasets, no filters. Stored as double
  * whatever the build precision. Every dataset has a string attribute Units: Coordinates "m",
  * Velocities "m/s", Densities "kg/m^3", Pressures "Pa", Masses "kg/m" (2D: per unit depth),
- * ParticleSizes "m", ParticleIDs, FreeSurface and Vertices "1", Keys and Values "" (text). /Header
+ * ParticleSizes "m", ParticleIDs, FreeSurface and Vertices "1", Keys and Values "" (text). Then
+ * the view's extra datasets (v->extra, in order) with their units: real ones as double, N or
+ * N x 3 (z = 0), uint8 ones as uint8. /Header
  * also carries the strings Code ("rhod"), Precision (RHOD_REAL_NAME), CodeVersion (rhod_version())
  * and GitCommit (rhod_commit()). The file is built in memory, then written through
  * rhod_write_bytes_atomic. Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"),
@@ -49,13 +65,25 @@ int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
 /* Reads a snapshot written by rhod_write_snapshot (arrays malloc'd, double). Errors:
  * RHOD_ERR_READ (missing or unreadable file, missing dataset or attribute, wrong shape),
  * RHOD_ERR_MEMORY; out is then empty. rhod_snapshot_data_free accepts an emptied one. */
+/* An extra dataset read back: every /PartType0 dataset rhod_write_snapshot does not write
+ * itself, as rhod_snapshot_extra describes them (a real one with N x 3 values: comps 2,
+ * z dropped). */
+typedef struct {
+  char *name, *units;
+  int u8, comps;
+  double *v;  /* n * comps values (x, y interleaved), when !u8 */
+  uint8_t *b; /* n values, when u8 */
+} rhod_snapshot_extra_data;
+
 typedef struct {
   double time;
   size_t n;
   double *x, *y, *ux, *uy, *rho, *p, *m, *size;
   uint64_t *id;
-  uint8_t *fs;            /* FreeSurface, NULL when the file has none */
-  uint8_t *phase;         /* Phase, NULL when the file has none */
+  uint8_t *fs;     /* FreeSurface, NULL when the file has none */
+  uint8_t *phase;  /* Phase, NULL when the file has none */
+  unsigned nextra; /* the other datasets of /PartType0, in name order */
+  rhod_snapshot_extra_data *extra;
   rhod_param_list params; /* /Parameters (Keys and Values; in older files the attributes)
                              in file order; owned here, freed by
                              rhod_snapshot_data_free (not rhod_param_list_free) */
@@ -81,6 +109,12 @@ unsigned rhod_snapshot_fields(const rhod_snapshot_view *v);
  * Rewritten (atomically) after each snapshot. */
 int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
                     unsigned fields, char *err, size_t errlen);
+/* The same with the extra datasets of the snapshots (every snapshot of a run has the same):
+ * after the fixed attributes, one node attribute each, named as the dataset (Scalar, or
+ * Vector for comps 2; UChar for uint8). */
+int rhod_write_xdmf_fields(const char *dir, int count, const double *times, const size_t *nparts,
+                           unsigned fields, const rhod_snapshot_extra *extra, unsigned nextra,
+                           char *err, size_t errlen);
 
 /* The closed outline of a shape as a polygon: a rect's 4 corners, a polygon's points,
  * a circle as `circle_segments` points (at least 8). out (may be NULL: count only) holds

@@ -157,6 +157,10 @@ typedef struct {
   double picture_range[2]; /* output.picture.range: colour scale limits (default: auto) */
   int picture_box_set;
   double picture_box_min[2], picture_box_max[2]; /* output.picture.box (default: domain) */
+  char **output_fields; /* output.fields: names of particle-store fields to write as well
+                           (rhod_scheme_ops.outputs); n_output_fields of them (at most
+                           RHOD_MAX_OUTPUT_FIELDS), default none */
+  unsigned n_output_fields;
   /* bookkeeping */
   char *name; /* name: default the file's base name without extension (the
                  folder's name for a file called scene.yaml) */
@@ -191,6 +195,9 @@ typedef struct {
   int count;
 } rhod_warn_buf;
 void rhod_warn(rhod_warn_buf *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* output.fields names at most (the extra datasets of a snapshot, io.h) */
+#define RHOD_MAX_OUTPUT_FIELDS 16
 
 /* Limits the loader enforces on what a run would write or hold (docs/choices.md "load-time
  * limits"): the picture's sides, the snapshots and probe rows a run writes, the steps

@@ -26,6 +26,14 @@ typedef struct {
 } rhod_stat;
 #define RHOD_MAX_STATS 16
 
+/* A field of the particle store that a scene may have written (output.fields): its name in
+ * the store (rhod_particles.fields[].name, which output.fields names), the dataset it
+ * becomes (/PartType0/<dataset>) and its unit. The store's entry gives the type: uint8
+ * (1 byte), or 1 or 2 reals per particle. Only where it is registered in the run. */
+typedef struct {
+  const char *field, *dataset, *units;
+} rhod_output_field;
+
 typedef struct rhod_scheme_ops {
   const char *name; /* scheme.name */
   /* Before the fill (s->sc, s->lo, s->hi set): the finest particle size the scene allows,
@@ -73,6 +81,11 @@ typedef struct rhod_scheme_ops {
   /* The scheme's output fields for the prepared state, on the host, into v (pressure,
    * free surface, phase ...); the engine adds the particles' own. */
   void (*output)(struct rhod_sim *s, rhod_snapshot_view *v);
+  /* The store's fields output.fields may name, ended by a { NULL } entry (NULL: none): only
+   * those whose values mean something at output time, i.e. persistent ones, or ones that
+   * `output` computes for the prepared state. When the scene names one, `output` runs with
+   * fresh ghosts and cells (rhod_sim_fetch rebuilds them, unsorted, after a step). */
+  const rhod_output_field *outputs;
   /* Statistics for the summary (count returned) and log lines for the end of a run
    * (rhod_warn into w). Either may be NULL. */
   int (*stats)(const struct rhod_sim *s, rhod_stat *out, int max);

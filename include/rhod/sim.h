@@ -102,8 +102,9 @@ unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MA
 void rhod_probe_values(rhod_sim *s, double *values);
 
 /* Brings the fluid's output fields to the host and points a snapshot view at them
- * (valid until the next step). */
-void rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v);
+ * (valid until the next step), the scene's output.fields among the view's extras. Returns
+ * RHOD_OK, or RHOD_ERR_MEMORY when the ghosts those fields need cannot be built. */
+int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v);
 
 /* The scheme's statistics and end-of-run lines (ops->stats, ops->report); none when the
  * scheme has no such hook. */

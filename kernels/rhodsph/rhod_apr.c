@@ -202,9 +202,9 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real *seg = b->seg, *circ = b->circ;
   const int nseg = b->nseg, ncirc = b->ncirc;
   const uint8_t *reg = s->reg, *near = a->near, *near2 = a->near2;
-  /* the free-surface particles alone (the region pass's subset of the cells) */
-  const rhod_grid Gf = c->sub->g;
-  const int32_t *CSf = c->sub->start, *CIf = c->sub->idx;
+  /* the free-surface particles alone (the region pass's subset cells, s->fsc) */
+  const rhod_grid Gf = s->fsc.g;
+  const int32_t *CSf = s->fsc.start, *CIf = s->fsc.idx;
   const real *sig = s->sig;
   uint8_t *mark = a->mark;
   real *sd = a->sd, *sp = a->sp;
@@ -263,7 +263,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i])) {
       /* Coalescing candidate: the criteria for the particle of size D = e dx_i at x_i
        * (HYST above). Criterion 3 first: no free-surface particle within HYST f e R_i,
-       * looked for among the free-surface particles alone (the cells' subset that the
+       * looked for among the free-surface particles alone (the subset cells fsc that the
        * region pass sorted), then one pass over the support e R_i:
        * no particle of size dx_i/e or less (criterion 1: it would be D/e^2) and the
        * Shepard field inside the thresholds with margin (criterion 5). Criterion 2

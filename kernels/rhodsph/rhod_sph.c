@@ -109,6 +109,11 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
   return st;
 }
 
+void rhod_sph_free(rhod_sph *s) {
+  rhod_cells_free(&s->fsc);
+  rhod_cells_free(&s->jsc);
+}
+
 void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   real *ux = p->ux, *uy = p->uy, *rho = p->rho, *P = s->P, *V = s->V;
@@ -432,11 +437,11 @@ void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p) {
  * jump particle has one of another size within max(R_i, R_j). Pass A flags those with one within
  * R_i; a coarser j with R_i <= r < R_j is itself flagged (i lies within its R_j), and so are the
  * ghosts. So a particle that pass A did not flag looks for such a j among the flagged ones alone
- * (the cells' subset, with their x, y, V and dx packed in its order), and skips even that when none
- * lies within the largest radius (two reads per row of the subset). Within R_i such a particle has
- * only neighbours of its own size, where M's sum is pass A's B (left in jM), so only the particles
- * pass A flagged gather M within R_i again. Writes jmp (1 at a jump) and jM (M there, 0 elsewhere)
- * of the fluid. */
+ * (the subset cells jsc, with their x, y, V and dx packed in its order), and skips even that when
+ * none lies within the largest radius (two reads per row of the subset). Within R_i such a particle
+ * has only neighbours of its own size, where M's sum is pass A's B (left in jM), so only the
+ * particles pass A flagged gather M within R_i again. Writes jmp (1 at a jump) and jM (M there, 0
+ * elsewhere) of the fluid. */
 PARTICLE_BODY void jumps_particle(long i, const rhod_grid G, const int32_t *CS, const rhod_grid GS,
                                   const int32_t *SS, const real *x, const real *y, const real *dx,
                                   const real *pk, long st, uint8_t *jmp, real *jM, const real ratio,
@@ -496,9 +501,9 @@ PARTICLE_BODY void jumps_particle(long i, const rhod_grid G, const int32_t *CS, 
   jM[3 * i] = mxx, jM[3 * i + 1] = mxy, jM[3 * i + 2] = myy;
 }
 
-void rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
+int rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   if (!rhod_sph_balanced(s) || !s->shifting)
-    return;
+    return RHOD_OK;
   const long n = (long)p->n, nt = (long)(p->n + p->ng), st = (long)p->cap;
   uint8_t *jmp = s->jmp;
   real *jM = s->jM, *pk = s->pk;
@@ -510,18 +515,22 @@ void rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++)
     jmp[g] = 1;
-  const long nf = rhod_cells_build_subset(c, jmp);
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JX * st, x, 1, 0);
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JY * st, y, 1, 0);
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JV * st, V, 1, 0);
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_JDX * st, dx, 1, 0);
-  const rhod_grid G = c->g, GS = c->sub->g;
-  const int32_t *CS = c->start, *SS = c->sub->start;
+  rhod_cells *u = &s->jsc;
+  const long nf = rhod_cells_build_subset(u, c, jmp);
+  if (nf < 0)
+    return RHOD_ERR_MEMORY;
+  rhod_cells_pack(u, nf, pk + RHOD_PK_JX * st, x, 1, 0);
+  rhod_cells_pack(u, nf, pk + RHOD_PK_JY * st, y, 1, 0);
+  rhod_cells_pack(u, nf, pk + RHOD_PK_JV * st, V, 1, 0);
+  rhod_cells_pack(u, nf, pk + RHOD_PK_JDX * st, dx, 1, 0);
+  const rhod_grid G = c->g, GS = u->g;
+  const int32_t *CS = c->start, *SS = u->start;
   const real ratio = s->ratio;
   const int kern = s->kernel, generic = s->generic;
   (void)generic;
   GATHER_BY_KERNEL(n, kern, generic, jumps_particle, G, CS, GS, SS, x, y, dx, pk, st, jmp, jM,
                    ratio, dmax);
+  return RHOD_OK;
 }
 
 /* Free-surface detection of Marrone et al. 2010 (paper 002 Ref. 51; scheme.md step 3):
@@ -626,7 +635,7 @@ void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p) {
 
 /* One particle's gather of the region pass (an inlined function, specialised for the
  * default kernel on the host as pass A's) over the free-surface particles alone (the
- * cells' subset, G and CS, with their positions and normals packed in its order): the
+ * subset cells fsc, G and CS, with their positions and normals packed in its order): the
  * sum of W n_j over those in the support (i itself included) and the nearest of them
  * other than i (r > 0, as PAIR_OR_SKIP). */
 PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
@@ -669,7 +678,7 @@ PARTICLE_BODY void region_particle(long i, RG_PARAMS, const int kern) {
   nt[2 * i + 1] = sn > 0 ? sy / sn : 0;
 }
 
-void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
+int rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   const long n = (long)p->n;
   uint8_t *reg = s->reg;
   real *nt = s->nt, *sig = s->sig;
@@ -681,23 +690,27 @@ void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c) {
       reg[i] = 0, sig[i] = 0;
       nt[2 * i] = 0, nt[2 * i + 1] = 0;
     }
-    return;
+    return RHOD_OK;
   }
-  /* the free-surface particles (fluid and ghosts) sorted into the cells alone, so that
-   * the gather visits only them, and a particle with none in reach skips it; their
-   * positions and normals packed in that order */
-  const long nf = rhod_cells_build_subset(c, fs), st = (long)p->cap;
-  const rhod_grid G = c->sub->g;
-  const int32_t *CS = c->sub->start;
+  /* the free-surface particles (fluid and ghosts) sorted into the cells alone (the
+   * subset fsc), so that the gather visits only them, and a particle with none in reach
+   * skips it; their positions and normals packed in that order */
+  rhod_cells *u = &s->fsc;
+  const long nf = rhod_cells_build_subset(u, c, fs), st = (long)p->cap;
+  if (nf < 0)
+    return RHOD_ERR_MEMORY;
+  const rhod_grid G = u->g;
+  const int32_t *CS = u->start;
   real *pk = s->pk;
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FX * st, x, 1, 0);
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FY * st, y, 1, 0);
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FNX * st, nrm, 2, 0);
-  rhod_cells_pack(c->sub, nf, pk + RHOD_PK_FNY * st, nrm, 2, 1);
+  rhod_cells_pack(u, nf, pk + RHOD_PK_FX * st, x, 1, 0);
+  rhod_cells_pack(u, nf, pk + RHOD_PK_FY * st, y, 1, 0);
+  rhod_cells_pack(u, nf, pk + RHOD_PK_FNX * st, nrm, 2, 0);
+  rhod_cells_pack(u, nf, pk + RHOD_PK_FNY * st, nrm, 2, 1);
   const int kern = s->kernel, generic = s->generic;
   const real ratio = s->ratio;
   (void)generic;
   GATHER_BY_KERNEL(n, kern, generic, region_particle, RG_ARGS);
+  return RHOD_OK;
 }
 
 /* J_i = -R_i grad C_i (Eq. 25) projected in the free-surface region (Eq. 26), into the
@@ -776,14 +789,14 @@ void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt) {
  * the shifting direction (Eqs. 25-26) needs; the start of every right-hand side and of
  * every relaxation iteration. With jumps, the size jumps of pass C's momentum term too
  * (the relaxation does not need them). */
-static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c, int jumps) {
+static int gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c, int jumps) {
   rhod_sph_pass_a(s, p, c);
   rhod_sph_mirror_gradients(s, p);
-  if (jumps)
-    rhod_sph_pass_jumps(s, p, c);
+  if (jumps && rhod_sph_pass_jumps(s, p, c) != RHOD_OK)
+    return RHOD_ERR_MEMORY;
   rhod_sph_pass_free_surface(s, p, c);
   rhod_sph_mirror_surface(s, p);
-  rhod_sph_pass_region(s, p, c);
+  return rhod_sph_pass_region(s, p, c);
 }
 
 /* One iteration of the initial relaxation (particles.relax; our choice, docs/choices.md
@@ -803,8 +816,9 @@ static void gradients_and_surface(rhod_sph *s, rhod_particles *p, rhod_cells *c,
  * other particle's test. Needs the cells and ghosts of the current positions
  * (rhod_sim_prepare); moves the fluid particles only and leaves every other field as it
  * was. */
-void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx) {
-  gradients_and_surface(s, p, c, 0);
+int rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx) {
+  if (gradients_and_surface(s, p, c, 0) != RHOD_OK)
+    return RHOD_ERR_MEMORY;
   const long n = (long)p->n, st = (long)p->cap;
   real *x = p->x, *y = p->y;
   const real *gC = s->gC, *nt = s->nt, *sig = s->sig, *ggam = s->ggam, *dx = p->dx;
@@ -845,6 +859,7 @@ void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx
     }
     x[i] += f * Jx, y[i] += f * Jy;
   }
+  return RHOD_OK;
 }
 
 /* Pass C: the right-hand side of Eq. 3. The gather of one particle is an inlined
@@ -1095,10 +1110,12 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   }
 }
 
-void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt) {
-  gradients_and_surface(s, p, c, 1);
+int rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt) {
+  if (gradients_and_surface(s, p, c, 1) != RHOD_OK)
+    return RHOD_ERR_MEMORY;
   rhod_sph_pass_shift(s, p, dt);
   rhod_sph_pass_c(s, p, c);
+  return RHOD_OK;
 }
 
 /* sum m (x - a) x acc over the fluid */
@@ -1112,9 +1129,10 @@ static real torque_of_acc(const rhod_sph *s, const rhod_particles *p, real ax, r
   return t;
 }
 
-void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt, real ax,
-                            real ay, double out[RHOD_TQ_TERMS]) {
-  rhod_sph_rhs(s, p, c, dt);
+int rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt, real ax, real ay,
+                           double out[RHOD_TQ_TERMS]) {
+  if (rhod_sph_rhs(s, p, c, dt) != RHOD_OK)
+    return RHOD_ERR_MEMORY;
   const real tf = torque_of_acc(s, p, ax, ay); /* the full right-hand side */
   const long n = (long)p->n;
   const real *x = p->x, *y = p->y, *m = p->m, *ux = p->ux, *uy = p->uy, *du = s->du;
@@ -1148,6 +1166,7 @@ void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real 
   out[RHOD_TQ_SHIFTING] = tf - t3;
   out[RHOD_TQ_BODY] = bo;
   out[RHOD_TQ_MOTION] = mo;
+  return RHOD_OK;
 }
 
 /* The damper step limit (our choice; paper 002 does not discuss it; docs/choices.md

@@ -174,9 +174,26 @@ static void mp_output(rhod_sim *s, rhod_snapshot_view *v) {
   rhod_mp *m = rhod_mps(s);
   rhod_particles *p = &s->p;
   rhod_mp_fill_state(m, p);
+  /* with output.fields (mp_outputs), the colour pass's fields of this state: it writes
+   * only scratch that the next right-hand side computes again before reading it */
+  if (s->sc->n_output_fields && m->surface && s->neighbours_fresh) {
+    rhod_mp_pack(m, p, &s->cells);
+    rhod_mp_pass_colour(m, p, &s->cells);
+  }
   rhod_to_host(m->P, p->n * sizeof(real));
   v->p = m->P;
 }
+
+/* The fields output.fields may name: those of the equation of state (rhod_mp_fill_state)
+ * and, with surface tension, the colour pass's (paper 001 Eqs. 8-9), which mp_output
+ * computes. Not the curvature (Eq. 10): the main pass computes it with the accelerations,
+ * which the next time step may read. */
+static const rhod_output_field mp_outputs[] = {
+    {"mp_V", "Volumes", "m^2"}, {"mp_nu", "KinematicViscosities", "m^2/s"},
+    {"mp_col", "Colours", "1"}, {"mp_gC", "ColourGradients", "1/m"},
+    {"mp_nrm", "Normals", "1"}, {"mp_sig", "SurfaceTensions", "N/m"},
+    {NULL, NULL, NULL},
+};
 
 static int mp_stats(const rhod_sim *s, rhod_stat *out, int max) {
   const rhod_mps_state *ms = rhod_mps_of(s);
@@ -250,6 +267,7 @@ const rhod_scheme_ops rhod_multiphase_ops = {
     .end_step = NULL,
     .probe = mp_probe,
     .output = mp_output,
+    .outputs = mp_outputs,
     .stats = mp_stats,
     .report = mp_report,
     .save = mp_save,

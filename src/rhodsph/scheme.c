@@ -153,7 +153,9 @@ static int relax_initial(rhod_sim *s) {
       jumps_dx = p->dx[k] > jumps_dx ? p->dx[k] : jumps_dx;
   int st = RHOD_OK;
   for (int it = 0; it < s->sc->rs->relax && st == RHOD_OK; it++) {
-    rhod_sph_relax(&rs->sph, p, &s->cells, jumps_dx);
+    st = rhod_sph_relax(&rs->sph, p, &s->cells, jumps_dx);
+    if (st != RHOD_OK)
+      break;
     rhod_walls_guard(&s->bnd, p);
     st = rhod_sim_prepare(s, 1);
   }
@@ -178,8 +180,9 @@ static int refine_initial(rhod_sim *s, char *err, size_t errlen) {
    * particles in its first step at three, four and seven levels with that limit); the
    * cap of 4 levels rounds only bounds a cascade that would not settle. */
   for (int round = 1; round < 4 * sc->rs->levels; round++) {
-    rhod_sph_rhs(&rs->sph, p, &s->cells, (real)s->dt);
-    st = rhod_apr_mark(&rs->apr, &rs->sph, p, &s->cells, &s->bnd, 0, 0);
+    st = rhod_sph_rhs(&rs->sph, p, &s->cells, (real)s->dt);
+    if (st == RHOD_OK)
+      st = rhod_apr_mark(&rs->apr, &rs->sph, p, &s->cells, &s->bnd, 0, 0);
     const long split = st == RHOD_OK ? rhod_apr_split(&rs->apr, &rs->sph, p, &s->bnd) : -1;
     if (split < 0) {
       snprintf(err, errlen, "out of memory refining the initial particles");
@@ -209,8 +212,10 @@ static int rs_start(rhod_sim *s, char *err, size_t errlen) {
 }
 
 static void rs_free(rhod_sim *s) {
-  if (s->sch)
+  if (s->sch) {
     rhod_apr_free(&rhod_rs(s)->apr);
+    rhod_sph_free(&rhod_rs(s)->sph);
+  }
 }
 
 static void rs_ghost_state(rhod_sim *s) { rhod_sph_fill_state(&rhod_rs(s)->sph, &s->p); }
@@ -218,7 +223,9 @@ static void rs_ghost_state(rhod_sim *s) { rhod_sph_fill_state(&rhod_rs(s)->sph, 
 static int rs_rhs(rhod_sim *s, int stage, double t, real dt) {
   rhod_rhodsph *rs = rhod_rs(s);
   rhod_particles *p = &s->p;
-  rhod_sph_rhs(&rs->sph, p, &s->cells, dt);
+  const int st = rhod_sph_rhs(&rs->sph, p, &s->cells, dt);
+  if (st != RHOD_OK)
+    return st;
   /* the stiffness limit (docs/choices.md): the RK4 stages' stiffness over the inner
    * particles, where the right-hand side is smooth (the free-surface region switches
    * operators and sets between stages, which the stage differences would read as a
@@ -312,7 +319,9 @@ static int rs_probe(rhod_sim *s, const rhod_probe *pr, double *values) {
     /* one value per column the loader and rhod_probe_columns count for this kind */
     _Static_assert(RHOD_TQ_TERMS == RHOD_PROBE_MAX_COLUMNS, "torque_budget columns");
     double tq[RHOD_TQ_TERMS];
-    rhod_sph_torque_budget(h, p, &s->cells, (real)s->dt, ax, ay, tq);
+    if (rhod_sph_torque_budget(h, p, &s->cells, (real)s->dt, ax, ay, tq) != RHOD_OK)
+      for (int a = 0; a < RHOD_TQ_TERMS; a++)
+        tq[a] = NAN; /* out of memory: a column that is not finite stops the run */
     for (int a = 0; a < RHOD_TQ_TERMS; a++)
       values[k++] = tq[a];
     break;
@@ -340,6 +349,24 @@ static void rs_output(rhod_sim *s, rhod_snapshot_view *v) {
   v->p = rs->sph.P;
   v->fs = rs->sph.fs;
 }
+
+/* The fields output.fields may name: the volume (rhod_sph_fill_state above) and what
+ * pass A (paper 002 Eqs. 7, 14, 5, 29, U_char after Eq. 27, lambda) and the free-surface
+ * detection compute for the prepared state in rs_output (rhod_sim_fetch makes the
+ * neighbours fresh for them). Not the shifting velocity nor the region pass's fields: those
+ * need the region pass and dt, which the output does not run. */
+static const rhod_output_field rs_outputs[] = {
+    {"V", "Volumes", "m^2"},
+    {"gam", "ShepardGamma", "1"},
+    {"ggam", "ShepardGammaGradients", "1/m"},
+    {"gP", "PressureGradients", "Pa/m"},
+    {"D", "VelocityDivergences", "1/s"},
+    {"gC", "ConcentrationGradients", "1/m"},
+    {"uch", "CharacteristicVelocities", "m/s"},
+    {"lam", "SmallestEigenvalues", "1"},
+    {"nrm", "Normals", "1"},
+    {NULL, NULL, NULL},
+};
 
 static int rs_stats(const rhod_sim *s, rhod_stat *out, int max) {
   const rhod_rhodsph *rs = rhod_rs(s);
@@ -455,6 +482,7 @@ const rhod_scheme_ops rhod_rhodsph_ops = {
     .end_step = rs_end_step,
     .probe = rs_probe,
     .output = rs_output,
+    .outputs = rs_outputs,
     .stats = rs_stats,
     .report = rs_report,
     .save = rs_save,

@@ -17,8 +17,8 @@ enum { RHOD_DT_BY_EQ11, RHOD_DT_BY_DAMPER, RHOD_DT_BY_STIFFNESS };
  * Pass A packs the first rows (the state), pass C the rest (pass A's gradients, the
  * shifting velocity and rho). The cells must have been built over the fluid and the
  * ghosts. After a right-hand side (rhod_sph_rhs) both sets hold that stage's values,
- * which the refinement criteria read (rhod_apr_mark), and the cells' subset holds that
- * stage's free-surface particles (the region pass). */
+ * which the refinement criteria read (rhod_apr_mark), and the scheme's subset cells fsc
+ * hold that stage's free-surface particles (the region pass). */
 enum {
   RHOD_PK_X,
   RHOD_PK_Y,
@@ -39,14 +39,14 @@ enum {
   RHOD_PK_RHO, /* from RHOD_PK_D: pass C's */
   RHOD_PK_ROWS,
   /* the region pass's rows, in pass C's (packed again by pass C after it): the
-   * positions and normals of the free-surface particles, in the order of the cells'
-   * subset (rhod_cells_build_subset) */
+   * positions and normals of the free-surface particles, in the order of the subset
+   * cells fsc (rhod_cells_build_subset) */
   RHOD_PK_FX = RHOD_PK_D,
   RHOD_PK_FY = RHOD_PK_GPX,
   RHOD_PK_FNX = RHOD_PK_GPY,
   RHOD_PK_FNY = RHOD_PK_GU0,
   /* rhod_sph_pass_jumps' rows, in pass C's too: the positions, volumes and sizes of the
-   * particles it flagged, in the order of the cells' subset */
+   * particles it flagged, in the order of the subset cells jsc */
   RHOD_PK_JX = RHOD_PK_D,
   RHOD_PK_JY = RHOD_PK_GPX,
   RHOD_PK_JV = RHOD_PK_GPY,
@@ -106,13 +106,22 @@ typedef struct {
                              steps and checkpointed), its divergence (adD, 1) and gradient
                              (adG, 4) */
   real *adD, *adG;
+  /* neighbour structures of particle sets, subsets of the caller's cells (owned here,
+   * sized on first use by rhod_cells_build_subset, freed by rhod_sph_free): */
+  rhod_cells fsc; /* the free-surface particles (fluid and ghosts) of the last region
+                     pass, which rhod_apr_mark reads too */
+  rhod_cells jsc; /* the particles rhod_sph_pass_jumps flagged */
 } rhod_sph;
 
 int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p);
+/* Frees what the state owns besides the store's fields (its subset cells). */
+void rhod_sph_free(rhod_sph *s);
 
 /* One right-hand-side evaluation at the current positions: the neighbour structure
- * must be built (ghosts generated, cells sorted). Fills drho, acc, vel for the fluid. */
-void rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt);
+ * must be built (ghosts generated, cells sorted). Fills drho, acc, vel for the fluid.
+ * RHOD_ERR_MEMORY when a subset's cells cannot be allocated (the passes below return
+ * the same). */
+int rhod_sph_rhs(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt);
 
 /* Values of the ghosts from their sources (state part: u, P, rho, V), and the fluid
  * EOS. Called after the ghosts are built and before any gather. */
@@ -124,19 +133,19 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p);
 void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p);
 /* With a balanced scheme.shifting_switch (and shifting on): the size-jump flags and scatter
- * moments (jmp, jM) after pass A and its mirrors; it uses and leaves the cells' subset
- * (the region pass builds it again). Does nothing otherwise. */
-void rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, rhod_cells *c);
+ * moments (jmp, jM) after pass A and its mirrors, with the flagged particles in jsc. Does
+ * nothing otherwise. */
+int rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_pass_free_surface(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_mirror_surface(rhod_sph *s, rhod_particles *p);
-void rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, rhod_cells *c);
+int rhod_sph_pass_region(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 void rhod_sph_pass_shift(rhod_sph *s, rhod_particles *p, real dt);
 void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c);
 /* One iteration of the initial relaxation (particles.relax): moves the fluid particles
  * along the shifting direction J of Eqs. 25-26; cells and ghosts must be current. With
  * jumps_dx > 0 (the largest size present; particles.relax_where: jumps) only those within
  * reach of a particle of another size move. */
-void rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx);
+int rhod_sph_relax(rhod_sph *s, rhod_particles *p, rhod_cells *c, real jumps_dx);
 
 /* Target of the measured step limits: dt |lambda| of Eq. 9 (the damper step limit) and
  * dt times the stiffness of the RK4 stages (the stiffness limit) kept at or below this,
@@ -176,8 +185,8 @@ enum {
   RHOD_TQ_MOTION,
   RHOD_TQ_TERMS
 };
-void rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt, real ax,
-                            real ay, double out[RHOD_TQ_TERMS]);
+int rhod_sph_torque_budget(rhod_sph *s, rhod_particles *p, rhod_cells *c, real dt, real ax, real ay,
+                           double out[RHOD_TQ_TERMS]);
 
 /* Time step of Eq. 11 over the fluid, with adlim no more than RHOD_DT_TARGET / ad_lambda,
  * and with stlim no more than RHOD_DT_TARGET / st_lambda but at least RHOD_ST_FLOOR of the
