@@ -52,7 +52,7 @@ typedef struct {
 } buf;
 
 static void put(buf *w, const void *src, size_t n) {
-  if (w->oom)
+  if (w->oom || n == 0) /* nothing to copy (src may then be NULL: an empty string, no particles) */
     return;
   if (w->len + n > w->cap) {
     size_t cap = 2 * w->cap + n + 4096;
