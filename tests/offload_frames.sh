@@ -5,6 +5,7 @@
 # copies (this broke every wall ghost on a GPU while the host-fallback tests passed).
 # This compiles each source with kernels for nvptx, reads the PTX, and fails when a
 # simd body (an outlined `$_omp_fn$N` that is not a team-level `$impl`) has such a frame.
+# Objects are compiled -fPIC: a shared object may then refer to data defined elsewhere.
 # usage: offload_frames.sh SRC_DIR OFFLOAD_FLAGS... (the build's own, from CMake)
 set -euo pipefail
 SRC=$(cd "$1" && pwd)
@@ -17,7 +18,7 @@ checked=0
 for f in $(grep -l -E "RHOD_KERNEL_LOOP|omp target" "$SRC"/kernels/*.c "$SRC"/kernels/*/*.c "$SRC"/src/*.c \
   "$SRC"/src/*/*.c); do
   b=$(basename "$f" .c)
-  (cd "$TMP" && gcc -O2 "${FLAGS[@]}" -I"$SRC/include" -I"$SRC/kernels" -I"$SRC/src" \
+  (cd "$TMP" && gcc -O2 -fPIC "${FLAGS[@]}" -I"$SRC/include" -I"$SRC/kernels" -I"$SRC/src" \
     -DRHOD_OFFLOAD=1 -c "$f" -o "$b.o" &&
     gcc "${FLAGS[@]}" -no-pie -shared -o "$b.so" "$b.o" 2>/dev/null)
   # the offload image holds our module first, then libgomp's and libm's
