@@ -37,6 +37,12 @@ typedef struct {
   const uint8_t *phase; /* phase index (the scene's phases, in order), may be NULL */
   unsigned nextra;      /* the extra datasets, in this order */
   rhod_snapshot_extra extra[RHOD_MAX_EXTRA_FIELDS];
+  /* the bodies (scene's bodies, in order) where they stand at this time, may be none:
+   * body k's outline is the closed polygon of points [body_start[k], body_start[k + 1])
+   * of body_xy (x, y interleaved); a circle's with segments of at most dx/4 */
+  unsigned n_bodies;
+  const unsigned *body_start; /* n_bodies + 1 */
+  const double *body_xy;
 } rhod_snapshot_view;
 
 /* Checks every value of v before it is written: positions, velocities and pressures

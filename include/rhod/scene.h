@@ -82,6 +82,43 @@ typedef struct {
                             counter-clockwise order); 0 when the velocity is zero */
 } rhod_wall;
 
+/* bodies.N.motion: how a body moves (include/rhod/body.h). */
+typedef enum {
+  RHOD_MOTION_FIXED = 0, /* at rest (the default) */
+  RHOD_MOTION_IMPOSED,   /* a law of time in the scene */
+  RHOD_MOTION_FREE       /* 2D rigid-body dynamics under the fluid's force and gravity */
+} rhod_motion_kind;
+
+/* bodies.N.lock: the degrees of freedom a free body keeps fixed */
+enum { RHOD_DOF_X = 0, RHOD_DOF_Y, RHOD_DOF_THETA, RHOD_NDOF };
+
+/* A rigid body: an obstacle (fluid outside) whose boundary is modelled by ghost particles,
+ * that may move, and on which the fluid's force and moment are measured every step. The
+ * loader resolves every default: after it, center, mass and inertia are the values a run
+ * uses. */
+typedef struct {
+  char *name;              /* bodies.N.name: probes.csv columns NAME_Fx ...; default "bodyN" */
+  rhod_shape shape;        /* rect, polygon or circle, where the body stands at zero
+                              displacement (the law's x = y = theta = 0) */
+  rhod_slip slip;          /* free (default) or no */
+  int refine;              /* bodies.N.refine: refinement criterion 4 near this body (paper 002
+                              Sec. V B); default 1 */
+  rhod_motion_kind motion; /* bodies.N.motion, default fixed */
+  double center[2];        /* bodies.N.center: the reference point G at zero displacement
+                              (rotation centre; a free body's centre of mass) [m]; default
+                              the shape's centroid */
+  char *law[RHOD_NDOF];    /* imposed: bodies.N.law.{x, y, theta}: G's displacement [m] and
+                              the rotation about G [rad, counter-clockwise] as expressions of
+                              t [s] (libmatheval syntax); NULL where not given (0) */
+  double mass;             /* free: per unit depth [kg/m] (bodies.N.mass, or density x area) */
+  double density;          /* free: bodies.N.density [kg/m^3] as given, 0 when mass was */
+  double inertia;          /* free: moment of inertia about G per unit depth [kg m]
+                              (bodies.N.inertia; default: the shape's, uniform density) */
+  int lock[RHOD_NDOF];     /* free: bodies.N.lock, 1 where that DOF is held */
+  double velocity[2];      /* free: initial velocity of G [m/s], default [0, 0] */
+  double omega;            /* free: initial angular velocity [1/s], default 0 */
+} rhod_body;
+
 typedef enum {
   RHOD_PROBE_PRESSURE = 0,     /* Shepard-interpolated pressure at a point [Pa] */
   RHOD_PROBE_KINETIC_ENERGY,   /* sum 1/2 m |u|^2 [J/m] */
@@ -143,6 +180,8 @@ typedef struct {
   unsigned n_fluid;
   rhod_wall *walls;
   unsigned n_walls;
+  rhod_body *bodies; /* bodies: rigid bodies (obstacles), in order */
+  unsigned n_bodies;
   rhod_probe *probes;
   unsigned n_probes;
   double probe_every; /* probes.every [s]: sampling interval, default output_every/10 */
