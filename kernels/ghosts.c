@@ -2,36 +2,90 @@
  * device: count per particle, scan, fill. */
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
+#include "rhod/kernel.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Mirrors of (x, y) in the walls within R: positions, Jacobians J, velocity transforms
- * T (row-major 2x2) and the moving walls' part U of the ghost velocity u' = T u + U.
- * Free slip: T = J (normal velocity reversed), U = 0 (a wall's motion along itself does
- * not act on a free-slip fluid); no slip: T = -I (both components reversed), U = 2 u_wall,
- * so that the mean of u and u' is the wall's velocity. Returns the count; with gx NULL it
- * only counts. The outputs are written straight into the ghost arrays (gx[k], J[4k]):
- * a local array here would sit in GCC 12's per-warp nvptx frame, shared by the 32
- * lanes of a simd loop, and the lanes would overwrite each other's mirrors
- * (tools/check_offload_frames.sh guards against any such array in a kernel). */
+/* Whether (x, y) is mirrored in segment S: in front of it by less than R, its foot on it. */
+static inline int seg_near(const real *S, real x, real y, real R) {
+  const real rx = x - S[0], ry = y - S[1];
+  const real d = S[2] * rx + S[3] * ry;
+  const real t = S[4] * rx + S[5] * ry;
+  return d > 0 && d < R && t >= 0 && t <= S[6];
+}
+
+/* Squared distance from (x, y) to segment S (its end points included). */
+static inline real seg_dist2(const real *S, real x, real y) {
+  const real rx = x - S[0], ry = y - S[1];
+  real t = S[4] * rx + S[5] * ry;
+  t = t < 0 ? 0 : (t > S[6] ? S[6] : t);
+  const real ex = rx - t * S[4], ey = ry - t * S[5];
+  return ex * ex + ey * ey;
+}
+
+/* A body's boundary velocity and acceleration at (fx, fy) from its kinematics K
+ * (RHOD_KIN_STRIDE): u_w = U + Omega x r, a_w = A + dOmega/dt x r - Omega^2 r, r = f - G. */
+static inline void body_kin(const real *K, real fx, real fy, real *uw, real *aw) {
+  const real rx = fx - K[0], ry = fy - K[1], W = K[4], Wd = K[7];
+  uw[0] = K[2] - W * ry, uw[1] = K[3] + W * rx;
+  aw[0] = K[5] - Wd * ry - W * W * rx, aw[1] = K[6] + Wd * rx - W * W * ry;
+}
+
+/* A body ghost's wall parts (docs/choices.md "bodies"): u_g = u_w + T (u_s - u_w), so
+ * U = (I - T) u_w; A = a_w. */
+static inline void body_ghost(const real *K, real fx, real fy, const real *Tn, real *Un, real *An) {
+  real uw[2], aw[2];
+  body_kin(K, fx, fy, uw, aw);
+  Un[0] = uw[0] - (Tn[0] * uw[0] + Tn[1] * uw[1]);
+  Un[1] = uw[1] - (Tn[2] * uw[0] + Tn[3] * uw[1]);
+  if (An)
+    An[0] = aw[0], An[1] = aw[1];
+}
+
+/* Mirrors of (x, y) in the walls and bodies within R: positions, Jacobians J, velocity
+ * transforms T (row-major 2x2), the moving walls' part U of the ghost velocity u' = T u + U,
+ * and with bodies (A, B not NULL) the boundary's acceleration A and the body index B; M
+ * the ghost's mass from the source's ms. Free slip: T = J (normal velocity reversed), U = 0
+ * for a wall (a wall's motion along itself does not act on a free-slip fluid); no slip:
+ * T = -I (both components reversed), U = 2 u_wall, so that the mean of u and u' is the
+ * wall's velocity. Returns the count; with gx NULL it only counts. The outputs are written
+ * straight into the ghost arrays (gx[k], J[4k]): a local array here would sit in GCC 12's
+ * per-warp nvptx frame, shared by the 32 lanes of a simd loop, and the lanes would
+ * overwrite each other's mirrors (tools/check_offload_frames.sh guards against any such
+ * array in a kernel). */
 static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner, int ncorner,
-                               const real *circ, int ncirc, real x, real y, real R, real *gx,
-                               real *gy, real *J, real *T, real *U) {
+                               const real *circ, int ncirc, const real *kin, real x, real y, real R,
+                               real ms, real *gx, real *gy, real *J, real *T, real *U, real *A,
+                               int32_t *B, real *M) {
   int n = 0;
-  unsigned near = 0; /* bit s: mirrored in segment s (first 32 segments) */
-  for (int s = 0; s < nseg && n < RHOD_MAX_GHOSTS_PER_PARTICLE; s++) {
+  for (int s = 0; s < nseg; s++) {
     const real *S = seg + RHOD_SEG_STRIDE * s;
     const real rx = x - S[0], ry = y - S[1];
     const real d = S[2] * rx + S[3] * ry;
     const real t = S[4] * rx + S[5] * ry;
     if (!(d > 0 && d < R && t >= 0 && t <= S[6]))
       continue;
-    if (s < 32)
-      near |= 1u << s;
+    const real qx = x - 2 * d * S[2], qy = y - 2 * d * S[3];
+    const int body = (int)S[10];
+    if (body >= 0) {
+      /* our choice (docs/choices.md "bodies"): the ghost belongs to the nearest face of
+       * its body, so that the images of two faces never overlap at a convex vertex */
+      const int first = (int)S[11], count = (int)S[12];
+      const real lo = d * d * (1 - 2 * RHOD_SUPPORT_TIE), hi = d * d * (1 + 2 * RHOD_SUPPORT_TIE);
+      int other = 0;
+      for (int s2 = first; s2 < first + count && !other; s2++) {
+        /* a tie (the bisector of a corner) goes to the lower segment index */
+        const real e2 = seg_dist2(seg + RHOD_SEG_STRIDE * s2, qx, qy);
+        other = s2 != s && (e2 < lo || (e2 <= hi && s2 < s));
+      }
+      if (other)
+        continue;
+    }
     if (gx) {
-      gx[n] = x - 2 * d * S[2];
-      gy[n] = y - 2 * d * S[3];
+      gx[n] = qx;
+      gy[n] = qy;
+      M[n] = ms;
       real *Jn = J + 4 * n, *Tn = T + 4 * n, *Un = U + 2 * n;
       Jn[0] = 1 - 2 * S[2] * S[2];
       Jn[1] = -2 * S[2] * S[3];
@@ -45,19 +99,26 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
           Tn[k] = Jn[k];
         Un[0] = 0, Un[1] = 0;
       }
+      if (body >= 0)
+        body_ghost(kin + RHOD_KIN_STRIDE * body, x - d * S[2], y - d * S[3], Tn, Un,
+                   A ? A + 2 * n : NULL);
+      else if (A)
+        A[2 * n] = 0, A[2 * n + 1] = 0;
+      if (B)
+        B[n] = body;
     }
     n++;
   }
-  for (int c = 0; c < ncorner && n < RHOD_MAX_GHOSTS_PER_PARTICLE; c++) {
+  for (int c = 0; c < ncorner; c++) {
     const int a = corner[2 * c], b = corner[2 * c + 1];
-    if (a >= 32 || b >= 32 || !((near >> a) & 1u) || !((near >> b) & 1u))
+    const real *A_ = seg + RHOD_SEG_STRIDE * a, *B_ = seg + RHOD_SEG_STRIDE * b;
+    if (!seg_near(A_, x, y, R) || !seg_near(B_, x, y, R))
       continue;
-    const real *A = seg + RHOD_SEG_STRIDE * a, *B = seg + RHOD_SEG_STRIDE * b;
     /* reflect in a, then in b */
-    const real da = A[2] * (x - A[0]) + A[3] * (y - A[1]);
-    const real x1 = x - 2 * da * A[2], y1 = y - 2 * da * A[3];
-    const real db = B[2] * (x1 - B[0]) + B[3] * (y1 - B[1]);
-    const real x2 = x1 - 2 * db * B[2], y2 = y1 - 2 * db * B[3];
+    const real da = A_[2] * (x - A_[0]) + A_[3] * (y - A_[1]);
+    const real x1 = x - 2 * da * A_[2], y1 = y - 2 * da * A_[3];
+    const real db = B_[2] * (x1 - B_[0]) + B_[3] * (y1 - B_[1]);
+    const real x2 = x1 - 2 * db * B_[2], y2 = y1 - 2 * db * B_[3];
     /* the corner ghost lies 2 rho from its source (rho the distance to the corner)
      * and at least rho from any particle on the fluid side: it is needed when
      * rho < R, i.e. closer than 2R to its source (it was R until 2026-11-22, which
@@ -68,33 +129,41 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     if (gx) {
       gx[n] = x2;
       gy[n] = y2;
+      M[n] = ms;
       /* J = Jb Ja, each a reflection I - 2 e e^T (symmetric) */
-      const real a0 = 1 - 2 * A[2] * A[2], a1 = -2 * A[2] * A[3], a3 = 1 - 2 * A[3] * A[3];
-      const real b0 = 1 - 2 * B[2] * B[2], b1 = -2 * B[2] * B[3], b3 = 1 - 2 * B[3] * B[3];
+      const real a0 = 1 - 2 * A_[2] * A_[2], a1 = -2 * A_[2] * A_[3], a3 = 1 - 2 * A_[3] * A_[3];
+      const real b0 = 1 - 2 * B_[2] * B_[2], b1 = -2 * B_[2] * B_[3], b3 = 1 - 2 * B_[3] * B_[3];
       real *Jn = J + 4 * n, *Tn = T + 4 * n, *Un = U + 2 * n;
       Jn[0] = b0 * a0 + b1 * a1;
       Jn[1] = b0 * a1 + b1 * a3;
       Jn[2] = b1 * a0 + b3 * a1;
       Jn[3] = b1 * a1 + b3 * a3;
-      if (A[7] != 0 || B[7] != 0) {
+      if (A_[7] != 0 || B_[7] != 0) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
         /* our choice (docs/choices.md "moving walls at corners"): with T = -I the corner
          * ghost is a no-slip mirror of the corner, whose velocity is the mean of the
          * no-slip walls meeting there (a free-slip wall imposes none): U = 2 u_corner.
          * Composing the two mirrors, T_b (T_a u + U_a) + U_b, would give -U_a + U_b for
          * two no-slip walls: the lid's velocity reversed at one of a cavity's corners */
-        const real na = A[7] != 0 ? 1 : 0, nb = B[7] != 0 ? 1 : 0;
-        Un[0] = 2 * (na * A[8] + nb * B[8]) / (na + nb);
-        Un[1] = 2 * (na * A[9] + nb * B[9]) / (na + nb);
+        const real na = A_[7] != 0 ? 1 : 0, nb = B_[7] != 0 ? 1 : 0;
+        Un[0] = 2 * (na * A_[8] + nb * B_[8]) / (na + nb);
+        Un[1] = 2 * (na * A_[9] + nb * B_[9]) / (na + nb);
       } else {
         for (int k = 0; k < 4; k++)
           Tn[k] = Jn[k];
         Un[0] = 0, Un[1] = 0; /* T_b (T_a u + 0) + 0: free slip on both */
       }
+      const int body = (int)A_[10];
+      if (body >= 0) /* a body's concave vertex: the kinematics at the vertex, b's start */
+        body_ghost(kin + RHOD_KIN_STRIDE * body, B_[0], B_[1], Tn, Un, A ? A + 2 * n : NULL);
+      else if (A)
+        A[2 * n] = 0, A[2 * n + 1] = 0;
+      if (B)
+        B[n] = body;
     }
     n++;
   }
-  for (int c = 0; c < ncirc && n < RHOD_MAX_GHOSTS_PER_PARTICLE; c++) {
+  for (int c = 0; c < ncirc; c++) {
     const real *C = circ + RHOD_CIRC_STRIDE * c;
     const real rx = x - C[0], ry = y - C[1];
     const real dist = sqrt(rx * rx + ry * ry);
@@ -110,9 +179,13 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       const real ex = rx / dist, ey = ry / dist;
       gx[n] = C[0] + rg * ex;
       gy[n] = C[1] + rg * ey;
+      /* the radial mirror r -> 2a - r maps r dr dphi onto r_g dr dphi: the image of the
+       * source's area is r_g / r_s of it (docs/choices.md "bodies": a constant mass
+       * over-weighted the ghosts of a convex obstacle by up to 7.5 %) */
+      M[n] = ms * (rg / dist);
       /* local mirror in the tangent line */
       real *Jn = J + 4 * n, *Tn = T + 4 * n, *Un = U + 2 * n;
-      Un[0] = 0, Un[1] = 0; /* a circle does not move */
+      Un[0] = 0, Un[1] = 0; /* a wall's circle does not move */
       Jn[0] = 1 - 2 * ex * ex;
       Jn[1] = -2 * ex * ey;
       Jn[2] = Jn[1];
@@ -123,6 +196,14 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
         for (int k = 0; k < 4; k++)
           Tn[k] = Jn[k];
       }
+      const int body = (int)C[5];
+      if (body >= 0)
+        body_ghost(kin + RHOD_KIN_STRIDE * body, C[0] + C[2] * ex, C[1] + C[2] * ey, Tn, Un,
+                   A ? A + 2 * n : NULL);
+      else if (A)
+        A[2 * n] = 0, A[2 * n + 1] = 0;
+      if (B)
+        B[n] = body;
     }
     n++;
   }
@@ -138,15 +219,41 @@ static int ensure_count(rhod_boundary *b, size_t need) {
   return b->count ? RHOD_OK : RHOD_ERR_MEMORY;
 }
 
+/* Whether a support of radius R at (x, y) reaches a body with its refine flag set: by the
+ * distance to its segments (vertices included) and circles (paper 002 criterion 4, per
+ * body). */
+static inline int body_near(const real *seg, int nseg, const real *circ, int ncirc, real x, real y,
+                            real R) {
+  for (int s = 0; s < nseg; s++) {
+    const real *S = seg + RHOD_SEG_STRIDE * s;
+    if (S[10] >= 0 && S[13] != 0 && seg_dist2(S, x, y) < R * R)
+      return 1;
+  }
+  for (int c = 0; c < ncirc; c++) {
+    const real *C = circ + RHOD_CIRC_STRIDE * c;
+    const real rx = x - C[0], ry = y - C[1];
+    const real d = sqrt(rx * rx + ry * ry) - C[2];
+    if (C[5] >= 0 && C[6] != 0 && d < R && d > -R)
+      return 1;
+  }
+  return 0;
+}
+
 void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real ratio, uint8_t *near) {
-  const int nseg = b->nseg, ncorner = b->ncorner, ncirc = b->ncirc;
+  /* walls: where i has a mirror; bodies: by distance */
+  const int nseg = b->nwallseg, ncorner = b->ncorner, ncirc = b->nwallcirc;
+  const int nbs = b->nseg, nbc = b->ncirc, bodies = b->nbody > 0;
   const real *seg = b->seg, *circ = b->circ, *x = p->x, *y = p->y, *dx = p->dx;
   const int32_t *corner = b->corner;
   const long n = (long)p->n;
   RHOD_KERNEL_LOOP
-  for (long i = 0; i < n; i++)
-    near[i] = nseg + ncirc > 0 && wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i],
-                                               ratio * dx[i], NULL, NULL, NULL, NULL, NULL) > 0;
+  for (long i = 0; i < n; i++) {
+    const real R = ratio * dx[i];
+    near[i] = (nseg + ncirc > 0 &&
+               wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, NULL, x[i], y[i], R, 0, NULL,
+                            NULL, NULL, NULL, NULL, NULL, NULL, NULL) > 0) ||
+              (bodies && body_near(seg, nbs, circ, nbc, x[i], y[i], R));
+  }
 }
 
 /* Phase 1: wall mirrors of the fluid. Returns the number of ghosts written or < 0. */
@@ -158,7 +265,7 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
   if (ensure_count(b, p->n + 1) != RHOD_OK)
     return -1;
   for (;;) {
-    const real *seg = b->seg, *circ = b->circ;
+    const real *seg = b->seg, *circ = b->circ, *kin = b->kin;
     const int32_t *corner = b->corner;
     int32_t *cnt = b->count;
     const real *x = p->x, *y = p->y, *dx = p->dx;
@@ -168,8 +275,8 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
         cnt[i] = 0;
         continue;
       }
-      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, x[i], y[i], ratio * dx[i],
-                            NULL, NULL, NULL, NULL, NULL);
+      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, x[i], y[i], ratio * dx[i],
+                            0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)n + 1);
     if (total < 0)
@@ -180,18 +287,18 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       continue; /* the arrays moved: count again */
     }
     real *gxo = p->x, *gyo = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
-    real *gU = p->gU;
-    int32_t *gsrc = p->gsrc;
+    real *gU = p->gU, *gA = p->gA;
+    int32_t *gsrc = p->gsrc, *gbody = p->gbody;
     RHOD_KERNEL_LOOP
     for (long i = 0; i < n; i++) {
       const int c = cnt[i + 1] - cnt[i];
       if (c == 0)
         continue;
       const long base = n + cnt[i];
-      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, gxo[i], gyo[i], ratio * gdx[i],
-                   gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base, gU + 2 * base);
+      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, gxo[i], gyo[i], ratio * gdx[i],
+                   m[i], gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base, gU + 2 * base,
+                   gA ? gA + 2 * base : NULL, gbody ? gbody + base : NULL, m + base);
       for (long g = base; g < base + c; g++) {
-        m[g] = m[i];
         gdx[g] = gdx[i];
         gsrc[g] = (int32_t)i;
         ge[2 * g] = gxo[g] - gxo[i];
@@ -245,8 +352,8 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
       return -2;
     }
     real *X = p->x, *Y = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
-    real *gU = p->gU;
-    int32_t *gsrc = p->gsrc;
+    real *gU = p->gU, *gA = p->gA;
+    int32_t *gsrc = p->gsrc, *gbody = p->gbody;
     RHOD_KERNEL_LOOP
     for (long k = 0; k < nsrc; k++) {
       long g = nsrc + cnt[k];
@@ -271,6 +378,10 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
             gT[4 * g] = 1, gT[4 * g + 1] = 0, gT[4 * g + 2] = 0, gT[4 * g + 3] = 1;
             ge[2 * g] = 0, ge[2 * g + 1] = 0;
             gU[2 * g] = 0, gU[2 * g + 1] = 0;
+            if (gA)
+              gA[2 * g] = 0, gA[2 * g + 1] = 0;
+            if (gbody)
+              gbody[g] = -2; /* an image of the fluid (the force pass counts it as fluid) */
           } else {
             gsrc[g] = gsrc[k];
             for (int q = 0; q < 4; q++) {
@@ -279,6 +390,10 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
             }
             ge[2 * g] = ge[2 * k], ge[2 * g + 1] = ge[2 * k + 1];
             gU[2 * g] = gU[2 * k], gU[2 * g + 1] = gU[2 * k + 1];
+            if (gA)
+              gA[2 * g] = gA[2 * k], gA[2 * g + 1] = gA[2 * k + 1];
+            if (gbody) /* an image of a mirror: the force pass counts its original only */
+              gbody[g] = -1;
           }
           g++;
         }
@@ -318,7 +433,7 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
   if (nseg + ncirc == 0)
     return 0;
   const long n = (long)p->n;
-  const real *seg = b->seg, *circ = b->circ;
+  const real *seg = b->seg, *circ = b->circ, *kin = b->kin;
   const int32_t *corner = b->corner;
   const int ncorner = b->ncorner;
   real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy;
@@ -332,8 +447,15 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
       const real rx = x[i] - S[0], ry = y[i] - S[1];
       const real d = S[2] * rx + S[3] * ry, t = S[4] * rx + S[5] * ry;
       if (d <= 0 && d > -lim && t >= 0 && t <= S[6]) {
+        /* a body's boundary moves: the normal velocity relative to it is reflected */
+        real wx = 0, wy = 0;
+        if (S[10] >= 0) {
+          real uw[2], aw[2];
+          body_kin(kin + RHOD_KIN_STRIDE * (int)S[10], x[i] - d * S[2], y[i] - d * S[3], uw, aw);
+          wx = uw[0], wy = uw[1];
+        }
         x[i] -= 2 * d * S[2], y[i] -= 2 * d * S[3];
-        const real un = ux[i] * S[2] + uy[i] * S[3];
+        const real un = (ux[i] - wx) * S[2] + (uy[i] - wy) * S[3];
         if (un < 0)
           ux[i] -= 2 * un * S[2], uy[i] -= 2 * un * S[3];
         count++;
@@ -364,8 +486,15 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
       const real d = C[3] > 0 ? C[2] - dist : dist - C[2];
       if (d <= 0 && d > -lim && dist > 0) {
         const real ex = C[3] * (-rx / dist), ey = C[3] * (-ry / dist); /* into the fluid */
+        real wx = 0, wy = 0;
+        if (C[5] >= 0) {
+          real uw[2], aw[2];
+          body_kin(kin + RHOD_KIN_STRIDE * (int)C[5], C[0] + C[2] * rx / dist,
+                   C[1] + C[2] * ry / dist, uw, aw);
+          wx = uw[0], wy = uw[1];
+        }
         x[i] -= 2 * d * ex, y[i] -= 2 * d * ey;
-        const real un = ux[i] * ex + uy[i] * ey;
+        const real un = (ux[i] - wx) * ex + (uy[i] - wy) * ey;
         if (un < 0)
           ux[i] -= 2 * un * ex, uy[i] -= 2 * un * ey;
         count++;

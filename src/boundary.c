@@ -8,7 +8,7 @@
 /* Edge k (pt[k] to pt[k + 1]) moves at vel when bit k of `moving` is set. */
 static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
                         const double (*pt)[2], unsigned np, int fluid_inside, int noslip,
-                        const double vel[2], unsigned moving) {
+                        const double vel[2], unsigned moving, int body, int refine) {
   /* orientation: signed area > 0 for counter-clockwise */
   double area = 0;
   for (unsigned k = 0; k < np; k++) {
@@ -39,11 +39,17 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
     const int moves = k < 32 && ((moving >> k) & 1u);
     S[8] = moves ? (real)vel[0] : 0;
     S[9] = moves ? (real)vel[1] : 0;
+    S[10] = (real)body;
+    S[13] = (real)refine;
     (*nseg)++;
   }
   /* corners: edge k ends where edge k+1 starts; the fluid wedge there is narrower
    * than a half plane (needs a double mirror) when n_k . t_{k+1} > 0 */
   const int ne = *nseg - first;
+  for (int k = 0; k < ne; k++) {
+    s[RHOD_SEG_STRIDE * (first + k) + 11] = (real)first;
+    s[RHOD_SEG_STRIDE * (first + k) + 12] = (real)ne;
+  }
   for (int k = 0; k < ne; k++) {
     const int a = first + k, b = first + (k + 1) % ne;
     const real *A = s + RHOD_SEG_STRIDE * a, *B = s + RHOD_SEG_STRIDE * b;
@@ -60,6 +66,34 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
   return RHOD_OK;
 }
 
+/* Appends one shape's boundary: body -1 for a wall. */
+static int push_shape(rhod_boundary *b, const rhod_shape *sh, int fluid_inside, int noslip,
+                      const double vel[2], unsigned moving, int body, int refine) {
+  if (sh->kind == RHOD_SHAPE_RECT) {
+    const double *m = sh->min, *M = sh->max;
+    const double pts[4][2] = {{m[0], m[1]}, {M[0], m[1]}, {M[0], M[1]}, {m[0], M[1]}};
+    return push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner, pts, 4, fluid_inside, noslip,
+                        vel, moving, body, refine);
+  }
+  if (sh->kind == RHOD_SHAPE_POLYGON)
+    return push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner, (const double(*)[2])sh->points,
+                        sh->n_points, fluid_inside, noslip, vel, moving, body, refine);
+  real *c = realloc(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)(b->ncirc + 1));
+  if (!c)
+    return RHOD_ERR_MEMORY;
+  b->circ = c;
+  real *C = c + RHOD_CIRC_STRIDE * b->ncirc;
+  C[0] = (real)sh->center[0];
+  C[1] = (real)sh->center[1];
+  C[2] = (real)sh->radius;
+  C[3] = fluid_inside ? 1 : -1;
+  C[4] = (real)noslip;
+  C[5] = (real)body;
+  C[6] = (real)refine;
+  b->ncirc++;
+  return RHOD_OK;
+}
+
 int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2],
                        const double hi[2]) {
   memset(b, 0, sizeof *b);
@@ -70,35 +104,40 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
   }
   for (unsigned w = 0; w < sc->n_walls; w++) {
     const rhod_wall *W = &sc->walls[w];
-    const int noslip = W->slip == RHOD_SLIP_NO;
-    int st = RHOD_OK;
-    if (W->shape.kind == RHOD_SHAPE_RECT) {
-      const double *m = W->shape.min, *M = W->shape.max;
-      const double pts[4][2] = {{m[0], m[1]}, {M[0], m[1]}, {M[0], M[1]}, {m[0], M[1]}};
-      st = push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner, pts, 4, W->fluid_inside, noslip,
-                        W->velocity, W->moving_edges);
-    } else if (W->shape.kind == RHOD_SHAPE_POLYGON) {
-      st = push_polygon(&b->seg, &b->nseg, &b->corner, &b->ncorner,
-                        (const double(*)[2])W->shape.points, W->shape.n_points, W->fluid_inside,
-                        noslip, W->velocity, W->moving_edges);
-    } else {
-      real *c = realloc(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)(b->ncirc + 1));
-      if (!c)
-        return RHOD_ERR_MEMORY;
-      b->circ = c;
-      real *C = c + RHOD_CIRC_STRIDE * b->ncirc;
-      C[0] = (real)W->shape.center[0];
-      C[1] = (real)W->shape.center[1];
-      C[2] = (real)W->shape.radius;
-      C[3] = W->fluid_inside ? 1 : -1;
-      C[4] = (real)noslip;
-      b->ncirc++;
-    }
+    const int st = push_shape(b, &W->shape, W->fluid_inside, W->slip == RHOD_SLIP_NO, W->velocity,
+                              W->moving_edges, -1, 1);
     if (st != RHOD_OK)
       return st;
   }
+  b->nwallseg = b->nseg;
+  b->nwallcirc = b->ncirc;
+  /* bodies: obstacles (fluid outside), at zero displacement (body.h moves them) */
+  static const double still[2] = {0, 0};
+  for (unsigned k = 0; k < sc->n_bodies; k++) {
+    const rhod_body *B = &sc->bodies[k];
+    const int st =
+        push_shape(b, &B->shape, 0, B->slip == RHOD_SLIP_NO, still, 0, (int)k, B->refine);
+    if (st != RHOD_OK)
+      return st;
+    b->moving |= B->motion != RHOD_MOTION_FIXED;
+  }
+  b->nbody = (int)sc->n_bodies;
   for (int k = 0; k < b->nseg; k++)
     b->moving |= b->seg[RHOD_SEG_STRIDE * k + 8] != 0 || b->seg[RHOD_SEG_STRIDE * k + 9] != 0;
+  if (b->nbody > 0) {
+    const size_t ss = sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg;
+    const size_t cs = sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc;
+    b->seg0 = malloc(ss ? ss : 1);
+    b->circ0 = malloc(cs ? cs : 1);
+    b->kin = calloc((size_t)b->nbody * RHOD_KIN_STRIDE, sizeof(real));
+    if (!b->seg0 || !b->circ0 || !b->kin)
+      return RHOD_ERR_MEMORY;
+    if (ss)
+      memcpy(b->seg0, b->seg, ss);
+    if (cs)
+      memcpy(b->circ0, b->circ, cs);
+    rhod_dev_map(b->kin, sizeof(real) * RHOD_KIN_STRIDE * (size_t)b->nbody);
+  }
   rhod_dev_map(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
   rhod_dev_map(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
   rhod_dev_map(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
@@ -109,9 +148,14 @@ void rhod_boundary_free(rhod_boundary *b) {
   rhod_dev_unmap(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
   rhod_dev_unmap(b->corner, sizeof(int32_t) * 2 * (size_t)b->ncorner);
   rhod_dev_unmap(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
+  if (b->kin)
+    rhod_dev_unmap(b->kin, sizeof(real) * RHOD_KIN_STRIDE * (size_t)b->nbody);
   free(b->seg);
   free(b->corner);
   free(b->circ);
+  free(b->seg0);
+  free(b->circ0);
+  free(b->kin);
   rhod_dev_free(b->count, sizeof(int32_t) * b->count_cap);
   memset(b, 0, sizeof *b);
 }

@@ -355,8 +355,8 @@ typedef struct {
   size_t *snap_n;
   double *probe_vals;
   unsigned nprobe_cols;
-  const char *probe_names[RHOD_PROBE_COLUMNS_TOTAL];
-  char probe_buf[RHOD_PROBE_COLUMNS_TOTAL][RHOD_PROBE_NAME_MAX];
+  const char *probe_names[RHOD_RUN_COLUMNS_MAX];
+  char probe_buf[RHOD_RUN_COLUMNS_MAX][RHOD_PROBE_NAME_MAX];
   char where[256];
   /* checkpoints */
   const char *scene_arg;
@@ -380,7 +380,8 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
   ck.step = c->sim.step;
   ck.reflected = c->sim.reflected;
   if (c->sim.ops->save)
-    c->sim.ops->save(&c->sim, &ck); /* the scheme's scalars */
+    c->sim.ops->save(&c->sim, &ck);      /* the scheme's scalars */
+  rhod_bodies_save(&c->sim.bodies, &ck); /* and the bodies' motion */
   ck.picture_range[0] = c->pic_range[0];
   ck.picture_range[1] = c->pic_range[1];
   long pos = c->csv.f ? ftell(c->csv.f) : -1;
@@ -640,6 +641,14 @@ static int run(run_opts *o, const char *resume_out) {
       /* the scheme's scalars (and its dt: sizes may have been split since t = 0) */
       if (c.sim.ops->load)
         st = c.sim.ops->load(&c.sim, &ck, err, sizeof err);
+      if (st == RHOD_OK) {
+        st = rhod_bodies_load(&c.sim.bodies, &c.sim.bnd, &ck, err, sizeof err);
+        if (st != RHOD_OK) { /* "OUT/checkpoint.rhod: reason" */
+          char why[512];
+          snprintf(why, sizeof why, "%s", err);
+          snprintf(err, sizeof err, "%s/checkpoint.rhod: %s", resume_out, why);
+        }
+      }
     }
     if (st == RHOD_OK) {
       st = rhod_sim_prepare(&c.sim, 1);
@@ -681,7 +690,7 @@ static int run(run_opts *o, const char *resume_out) {
   g_stop = 0;
   install_signals();
   rhod_scene_params(c.sc, &c.params);
-  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, RHOD_PROBE_COLUMNS_TOTAL);
+  c.nprobe_cols = rhod_probe_columns(c.sc, c.probe_buf, c.probe_names, RHOD_RUN_COLUMNS_MAX);
   c.probe_vals = calloc(c.nprobe_cols + 1, sizeof(double));
   char path[4200];
   snprintf(path, sizeof path, "%s/probes.csv", out);

@@ -92,6 +92,15 @@ int rhod_particles_add_tags(rhod_particles *p) {
   return st;
 }
 
+int rhod_particles_add_body_fields(rhod_particles *p) {
+  int st = RHOD_OK;
+  if (!p->gA)
+    st = rhod_particles_add_field(p, "gA", (void **)&p->gA, 2 * sizeof(real), 0);
+  if (st == RHOD_OK && !p->gbody)
+    st = rhod_particles_add_field(p, "gbody", (void **)&p->gbody, sizeof(int32_t), 0);
+  return st;
+}
+
 int rhod_particles_reserve(rhod_particles *p, size_t cap) {
   if (cap <= p->cap)
     return RHOD_OK;

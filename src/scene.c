@@ -1608,6 +1608,9 @@ static int load_wall_motion(lctx *c, const y_wall *y, unsigned i, rhod_wall *w,
 }
 
 int rhod_scene_walls_move(const rhod_scene *s) {
+  for (unsigned i = 0; s && i < s->n_bodies; i++)
+    if (s->bodies[i].motion != RHOD_MOTION_FIXED)
+      return 1;
   for (unsigned i = 0; s && i < s->n_walls; i++)
     if (s->walls[i].moving_edges)
       return 1;

@@ -15,21 +15,30 @@
 #include <math.h>
 
 #define RHOD_SEG_STRIDE                                                                            \
-  10                       /* ax, ay, nx, ny, tx, ty, length, noslip, ux, uy (the edge's           \
-                              velocity along itself, walls.N.velocity; 0 at rest) */
-#define RHOD_CIRC_STRIDE 5 /* cx, cy, radius, side (+1 fluid inside, -1 outside), noslip */
-#define RHOD_MAX_GHOSTS_PER_PARTICLE 6
+  14 /* ax, ay, nx, ny, tx, ty, length, noslip, ux, uy (a wall edge's velocity along itself,       \
+        walls.N.velocity; 0 at rest), body (its index, -1 for a wall), first, count (the           \
+        body's segments), refine (1: refinement criterion 4 near it) */
+#define RHOD_CIRC_STRIDE                                                                           \
+  7 /* cx, cy, radius, side (+1 fluid inside, -1 outside), noslip, body (-1: a wall), refine */
+/* per body: G (x, y), its velocity (u, v), angular velocity Omega, G's acceleration (x, y),
+ * angular acceleration: the kinematics of a body's boundary (u_w = U + Omega x (x_w - G),
+ * a_w = A + dOmega/dt x r - Omega^2 r, r = x_w - G) */
+#define RHOD_KIN_STRIDE 8
 
 typedef struct {
   int nseg, ncorner, ncirc;
   real *seg;       /* nseg * RHOD_SEG_STRIDE; n is the normal pointing into the fluid */
   int32_t *corner; /* ncorner * 2: segments meeting at a corner that needs a double mirror */
   real *circ;      /* ncirc * RHOD_CIRC_STRIDE */
-  int moving;      /* some segment has a non-zero velocity */
+  int moving;      /* some segment has a non-zero velocity, or some body moves */
   int periodic[2];
   double lo[2], hi[2]; /* domain box */
   int32_t *count;      /* per-particle ghost counts (scan buffer), cap + 1 */
   size_t count_cap;
+  /* bodies (body.h): their segments and circles follow the walls' ones; seg0 and circ0
+   * (host) hold them at zero displacement, kin their kinematics (device) */
+  int nbody, nwallseg, nwallcirc;
+  real *seg0, *circ0, *kin;
 } rhod_boundary;
 
 /* Builds the wall segments, corners and circles of a scene, and the domain box. */
@@ -45,11 +54,22 @@ void rhod_boundary_free(rhod_boundary *b);
  * a free-slip one (T = J: the wall's tangential motion does not act); at a double mirror
  * in a corner (T = -I where either wall is no-slip, else J_b J_a) the mean of the
  * no-slip walls' 2 u_wall (docs/choices.md "moving walls at corners"); a periodic image
- * copies its source's. */
+ * copies its source's.
+ * A body's ghosts (docs/choices.md "bodies"): u_g = u_w + T (u_s - u_w), i.e. gU = (I - T) u_w
+ * with u_w the boundary's velocity at the mirror's foot (a vertex for a double mirror);
+ * when the store has them (rhod_particles_add_body_fields), gA = a_w there (0 for walls)
+ * and gbody = the body's index (-1 for walls, -2 for periodic images of the fluid, -1 for
+ * periodic images of mirrors: particles.h). A mirror in a body's
+ * segment is kept only where no other segment of that body lies nearer to the ghost than
+ * the mirrored one: the images of the two faces at a convex vertex would overlap. A
+ * circle's mirror carries m_s r_g / r_s, the area ratio of the radial mirror.
+ * No cap on the ghosts of a particle. */
 int rhod_ghosts_build(rhod_boundary *b, rhod_particles *p, real radius_ratio, real margin);
 
 /* near[i] = 1 when the support of fluid particle i (radius radius_ratio * dx_i)
- * reaches a wall, else 0 (refinement criterion 4 of paper 002 Sec. V B). */
+ * reaches a wall or a body whose refine flag is set, else 0 (refinement criterion 4 of
+ * paper 002 Sec. V B): for a wall, where i has a mirror in it; for a body, by the
+ * distance to its segments (vertices included) or circle. */
 void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real radius_ratio,
                      uint8_t *near);
 

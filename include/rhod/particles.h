@@ -41,10 +41,15 @@ typedef struct {
    * Jacobian J (x' = J x + c, row-major), velocity transform T, and the
    * displacement e used for the hydrostatic correction P' = P + rho g.e */
   int32_t *gsrc;
-  real *gJ, *gT; /* 4 per particle */
-  real *gU;      /* 2 per particle: the moving wall's part of the ghost velocity,
-                    u_g = T u_src + gU (boundary.h); 0 where no wall moves */
-  real *ge;      /* 2 per particle */
+  real *gJ, *gT;  /* 4 per particle */
+  real *gU;       /* 2 per particle: the moving wall's part of the ghost velocity,
+                     u_g = T u_src + gU (boundary.h); 0 where no wall moves */
+  real *ge;       /* 2 per particle */
+  real *gA;       /* 2 per particle: a body's boundary acceleration at the mirror's foot
+                     (the ghost pressure's g - a_w), 0 for walls; NULL without bodies */
+  int32_t *gbody; /* the body a ghost mirrors (its index); -2 for a periodic image of a
+                     fluid particle; -1 otherwise (a wall's mirror, an image of a mirror);
+                     NULL without bodies */
   /* scratch for reordering */
   void *scratch;
   size_t scratch_elem;
@@ -60,6 +65,8 @@ int rhod_particles_add_field(rhod_particles *p, const char *name, void **ptr, si
                              int persistent);
 /* Registers the tags phase, kind and level (zero-filled, persistent). */
 int rhod_particles_add_tags(rhod_particles *p);
+/* Registers gA and gbody (scratch; rhod_ghosts_build fills them): a scene with bodies. */
+int rhod_particles_add_body_fields(rhod_particles *p);
 /* Grows every array to at least `cap` (keeps content of persistent ones). */
 int rhod_particles_reserve(rhod_particles *p, size_t cap);
 void rhod_particles_free(rhod_particles *p);

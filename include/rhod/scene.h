@@ -135,6 +135,10 @@ typedef enum {
 #define RHOD_PROBE_MAX_COLUMNS 7
 /* columns of all the probes of a scene together, at most (the loader refuses more) */
 #define RHOD_PROBE_COLUMNS_TOTAL 64
+/* bodies at most (a run refuses more), and the probes.csv columns of a run at most: the
+ * probes' and RHOD_BODY_COLUMNS (body.h) per body */
+#define RHOD_MAX_BODIES 64
+#define RHOD_RUN_COLUMNS_MAX (RHOD_PROBE_COLUMNS_TOTAL + 9 * RHOD_MAX_BODIES)
 unsigned rhod_probe_ncolumns(rhod_probe_kind kind);
 const char *rhod_probe_suffix(rhod_probe_kind kind, unsigned column);
 
@@ -252,8 +256,8 @@ void rhod_warn(rhod_warn_buf *w, const char *fmt, ...) __attribute__((format(pri
  * blocks' bounding boxes (an upper estimate there). Before walls and domain cut it. */
 double rhod_scene_particle_estimate(const rhod_scene *s);
 
-/* Whether some wall edge moves (a non-zero walls.N.velocity): the ghosts then carry
- * their wall's velocity (rhod_particles.gU). */
+/* Whether some wall edge moves (a non-zero walls.N.velocity) or some body is not fixed:
+ * the ghosts then carry their wall's velocity (rhod_particles.gU). */
 int rhod_scene_walls_move(const rhod_scene *s);
 
 #endif

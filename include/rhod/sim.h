@@ -4,6 +4,7 @@
 #ifndef RHOD_SIM_H
 #define RHOD_SIM_H
 
+#include "rhod/body.h"
 #include "rhod/boundary.h"
 #include "rhod/cells.h"
 #include "rhod/integrator.h"
@@ -31,6 +32,8 @@ typedef struct rhod_sim {
   rhod_fill_stats *fill;      /* per fluid block, from rhod_sim_init */
   rhod_particles p;
   rhod_boundary bnd;
+  rhod_bodies bodies; /* the scene's bodies (body.h) */
+  double body_mu;     /* the dynamic viscosity of the bodies' force (the scheme's; 0 inviscid) */
   rhod_cells cells;
   rhod_rk rk;          /* made with the scene's time.integrator; the scheme adds its variables */
   real **P, **V;       /* the scheme's pressure and volume over fluid and ghosts after

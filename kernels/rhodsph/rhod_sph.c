@@ -117,7 +117,7 @@ void rhod_sph_free(rhod_sph *s) {
 void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   real *ux = p->ux, *uy = p->uy, *rho = p->rho, *P = s->P, *V = s->V;
-  const real *m = p->m, *gT = p->gT, *gU = p->gU, *ge = p->ge;
+  const real *m = p->m, *gT = p->gT, *gU = p->gU, *ge = p->ge, *gA = p->gA;
   const int32_t *gsrc = p->gsrc;
   const real c0 = s->c0, c2 = s->c0 * s->c0, rho0 = s->rho0, gx = s->gx, gy = s->gy;
   const int walls_move = s->walls_move;
@@ -147,7 +147,12 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
      * and their ghosts to pump mass upward through a tank at rest
      * (cases/hydrostatic/RESULTS.md). */
     const real Pk = c2 * (rho[k] - rho0);
-    const real a = (gx * ge[2 * g] + gy * ge[2 * g + 1]) / c2;
+    /* a moving body's ghost: g - a_w, the acceleration its boundary has at the mirror's
+     * foot (docs/choices.md "bodies"); gA is 0 for walls, absent without bodies */
+    real ax = gx, ay = gy;
+    if (gA)
+      ax -= gA[2 * g], ay -= gA[2 * g + 1];
+    const real a = (ax * ge[2 * g] + ay * ge[2 * g + 1]) / c2;
     const real Pg = Pk + rho[k] * c2 * expm1(a);
     P[g] = Pg;
     rho[g] = rho0 + Pg / c2;

@@ -1,0 +1,97 @@
+/* Rigid bodies (the scene's bodies: list): obstacles that rest, move by a law of time or
+ * move freely under the fluid's force, with the force and moment the fluid exerts on each.
+ * Engine side: both schemes use them. Paper 002 Sec. IV A states only "mirrored ghost
+ * particles" and forces "following Ref. 8"; the choices are in docs/choices.md ("bodies").
+ *
+ * A body's pose is the displacement d of its reference point G from G0 (bodies.N.center)
+ * and the rotation theta about G: a point X0 of the body as the scene gives it stands at
+ * G0 + d + R(theta) (X0 - G0). Its boundary is a set of segments or a circle in the ghost
+ * machinery (boundary.h), moved to the pose before each ghost build. */
+#ifndef RHOD_BODY_H
+#define RHOD_BODY_H
+
+#include "rhod/boundary.h"
+#include "rhod/cells.h"
+#include "rhod/checkpoint.h"
+#include "rhod/integrator.h"
+#include "rhod/particles.h"
+#include "rhod/scene.h"
+
+/* probes.csv columns a body adds, in this order after the scene's probes: NAME_Fx, NAME_Fy
+ * [N/m], NAME_Mz [N] (about G), NAME_x, NAME_y [m] (G), NAME_theta [rad], NAME_u, NAME_v
+ * [m/s] (G's velocity), NAME_omega [1/s] */
+#define RHOD_BODY_COLUMNS 9
+_Static_assert(RHOD_RUN_COLUMNS_MAX ==
+                   RHOD_PROBE_COLUMNS_TOTAL + RHOD_BODY_COLUMNS * RHOD_MAX_BODIES,
+               "scene.h counts 9 columns a body");
+extern const char *const rhod_body_column_suffix[RHOD_BODY_COLUMNS];
+
+typedef struct {
+  const rhod_body *desc;   /* the scene's */
+  void *law[RHOD_NDOF][3]; /* imposed: libmatheval evaluators of the law, its first and second
+                              derivatives (NULL where the law is 0) */
+  double G0[2];            /* G at zero displacement */
+  /* state: q = (d_x, d_y, theta), qd its rate; qdd the acceleration the ghost pressure uses */
+  double q[RHOD_NDOF], qd[RHOD_NDOF], qdd[RHOD_NDOF];
+  double q0[RHOD_NDOF], qd0[RHOD_NDOF], kq[RHOD_NDOF], kqd[RHOD_NDOF]; /* RK bookkeeping */
+  double F[3]; /* the fluid's force (Fx, Fy) and moment about G, last measured */
+  double area; /* the shape's */
+} rhod_body_state;
+
+typedef struct {
+  int n;
+  rhod_body_state *b;
+  int moving;   /* some body is not fixed */
+  real *fghost; /* scratch: per ghost (fx, fy) of the force pass, 2 reals, device */
+  size_t fghost_cap;
+} rhod_bodies;
+
+/* Compiles the laws, sets the initial pose (imposed: the law at t; free: at rest at zero
+ * displacement with the given velocities) and appends every body's boundary to b (after
+ * the walls, rhod_boundary_init) at that pose. Errors: RHOD_ERR_SCENE with a one-line
+ * message (a law libmatheval refuses), RHOD_ERR_MEMORY. */
+int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, double t, char *err,
+                     size_t errlen);
+void rhod_bodies_free(rhod_bodies *bb);
+
+/* Moves every body's boundary in b to its state (q, qd, qdd) and copies it to the device. */
+void rhod_bodies_place(const rhod_bodies *bb, rhod_boundary *b);
+
+/* Imposed bodies: q, qd, qdd from the law at time t (others unchanged). */
+void rhod_bodies_impose(rhod_bodies *bb, double t);
+
+/* The lockstep integration of free bodies with the fluid's Runge-Kutta method (the same
+ * stage table, integrator.h): begin before stage 0; after the forces of stage s are known
+ * (rhod_bodies_forces), stage sets the state for stage s + 1 at time t + c[s] dt, or the
+ * final one. Imposed bodies follow their law at the stage's time. Locked degrees of
+ * freedom keep their value and rate exactly. gravity: the scene's. */
+void rhod_bodies_begin(rhod_bodies *bb);
+void rhod_bodies_stage(rhod_bodies *bb, const rhod_rk_table *tab, int s, double t, double dt,
+                       const double gravity[2]);
+
+/* The fluid's force and moment on every body (into bb->b[k].F) from the prepared state:
+ * ghosts built (p->gbody set), cells over fluid and ghosts, P and V over both. The pair
+ * form of Bouscasse et al. 2013 (paper 002 Ref. 8), central pair forces:
+ *   F_B = sum_{j ghost of B} sum_{i fluid} [(P_i + P_j) - 2 (d + 2) mu pi_ij] grad_i W_ij V_i V_j,
+ *   M_B = sum (x_j - x_G) x [the same term],  pi_ij = (u_i - u_j).(x_i - x_j) / |x_i - x_j|^2,
+ * W with fluid particle i's radius (ratio dx_i). mu: the dynamic viscosity (0: inviscid).
+ * RHOD_ERR_MEMORY when the scratch cannot grow. */
+int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
+                       real ratio, const real *P, const real *V, real mu);
+
+/* The columns for probes.csv (RHOD_BODY_COLUMNS per body) at the current state. */
+void rhod_bodies_values(const rhod_bodies *bb, double *out);
+
+/* The outline of every body at its pose (circles with segments of at most seg_len):
+ * start (n + 1 entries) and xy (x, y interleaved) malloc'd into *start and *xy. */
+int rhod_bodies_outline(const rhod_bodies *bb, double seg_len, unsigned **start, double **xy);
+
+/* Checkpoint extras: per body its 9 numbers q, qd, qdd, named "body.K.q0" ... "body.K.qdd2".
+ * save appends them to ck's extras; load takes them back (every body's must be there:
+ * RHOD_ERR_CHECKPOINT naming the first missing one otherwise) and places the bodies. */
+#define RHOD_BODY_EXTRAS 9
+void rhod_bodies_save(const rhod_bodies *bb, rhod_checkpoint *ck);
+int rhod_bodies_load(rhod_bodies *bb, rhod_boundary *b, const rhod_checkpoint *ck, char *err,
+                     size_t errlen);
+
+#endif

@@ -1,0 +1,281 @@
+/* Rigid bodies, host side: laws of motion (libmatheval), poses, the lockstep integration
+ * of free bodies, probe columns, outlines and checkpoint extras (body.h). */
+#include "rhod/body.h"
+#include "rhod/kernel.h"
+#include <math.h>
+#include <matheval.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const rhod_body_column_suffix[RHOD_BODY_COLUMNS] = {
+    "_Fx", "_Fy", "_Mz", "_x", "_y", "_theta", "_u", "_v", "_omega"};
+
+static double shape_area(const rhod_shape *sh) {
+  if (sh->kind == RHOD_SHAPE_RECT)
+    return (sh->max[0] - sh->min[0]) * (sh->max[1] - sh->min[1]);
+  if (sh->kind == RHOD_SHAPE_CIRCLE)
+    return RHOD_PI * sh->radius * sh->radius;
+  double a = 0;
+  for (unsigned k = 0; k < sh->n_points; k++) {
+    const double *p = sh->points[k], *q = sh->points[(k + 1) % sh->n_points];
+    a += p[0] * q[1] - q[0] * p[1];
+  }
+  return fabs(a) / 2;
+}
+
+static double law_at(void *ev, double t) {
+  if (!ev)
+    return 0;
+  char *names[1] = {"t"};
+  double vals[1] = {t};
+  return evaluator_evaluate(ev, 1, names, vals);
+}
+
+void rhod_bodies_impose(rhod_bodies *bb, double t) {
+  for (int k = 0; k < bb->n; k++) {
+    rhod_body_state *B = &bb->b[k];
+    if (B->desc->motion != RHOD_MOTION_IMPOSED)
+      continue;
+    for (int d = 0; d < RHOD_NDOF; d++) {
+      B->q[d] = law_at(B->law[d][0], t);
+      B->qd[d] = law_at(B->law[d][1], t);
+      B->qdd[d] = law_at(B->law[d][2], t);
+    }
+  }
+}
+
+int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, double t, char *err,
+                     size_t errlen) {
+  memset(bb, 0, sizeof *bb);
+  if (sc->n_bodies == 0)
+    return RHOD_OK;
+  bb->b = calloc(sc->n_bodies, sizeof *bb->b);
+  if (!bb->b)
+    return RHOD_ERR_MEMORY;
+  bb->n = (int)sc->n_bodies;
+  static const char *const dof[RHOD_NDOF] = {"x", "y", "theta"};
+  for (int k = 0; k < bb->n; k++) {
+    rhod_body_state *B = &bb->b[k];
+    const rhod_body *D = &sc->bodies[k];
+    B->desc = D;
+    B->G0[0] = D->center[0], B->G0[1] = D->center[1];
+    B->area = shape_area(&D->shape);
+    bb->moving |= D->motion != RHOD_MOTION_FIXED;
+    if (D->motion == RHOD_MOTION_IMPOSED) {
+      for (int d = 0; d < RHOD_NDOF; d++) {
+        if (!D->law[d])
+          continue;
+        void *ev = evaluator_create(D->law[d]);
+        if (!ev) {
+          snprintf(err, errlen, "%s: bodies.%d.law.%s: cannot read \"%s\"", sc->path, k, dof[d],
+                   D->law[d]);
+          return RHOD_ERR_SCENE;
+        }
+        B->law[d][0] = ev;
+        B->law[d][1] = evaluator_derivative(ev, "t");
+        B->law[d][2] = B->law[d][1] ? evaluator_derivative(B->law[d][1], "t") : NULL;
+        if (!B->law[d][1] || !B->law[d][2])
+          return RHOD_ERR_MEMORY;
+      }
+    } else if (D->motion == RHOD_MOTION_FREE) {
+      B->qd[0] = D->lock[0] ? 0 : D->velocity[0];
+      B->qd[1] = D->lock[1] ? 0 : D->velocity[1];
+      B->qd[2] = D->lock[2] ? 0 : D->omega;
+    }
+  }
+  rhod_bodies_impose(bb, t);
+  rhod_bodies_place(bb, b);
+  return RHOD_OK;
+}
+
+void rhod_bodies_free(rhod_bodies *bb) {
+  for (int k = 0; k < bb->n; k++)
+    for (int d = 0; d < RHOD_NDOF; d++)
+      for (int o = 0; o < 3; o++)
+        if (bb->b[k].law[d][o])
+          evaluator_destroy(bb->b[k].law[d][o]);
+  free(bb->b);
+  rhod_dev_free(bb->fghost, sizeof(real) * 2 * bb->fghost_cap);
+  memset(bb, 0, sizeof *bb);
+}
+
+/* A point X0 of body B at zero displacement where the body stands now. */
+static void to_world(const rhod_body_state *B, double c, double s, double x0, double y0, double *x,
+                     double *y) {
+  const double rx = x0 - B->G0[0], ry = y0 - B->G0[1];
+  *x = B->G0[0] + B->q[0] + c * rx - s * ry;
+  *y = B->G0[1] + B->q[1] + s * rx + c * ry;
+}
+
+void rhod_bodies_place(const rhod_bodies *bb, rhod_boundary *b) {
+  if (bb->n == 0)
+    return;
+  for (int s = b->nwallseg; s < b->nseg; s++) {
+    const real *S0 = b->seg0 + RHOD_SEG_STRIDE * s;
+    real *S = b->seg + RHOD_SEG_STRIDE * s;
+    const rhod_body_state *B = &bb->b[(int)S0[10]];
+    const double c = cos(B->q[2]), sn = sin(B->q[2]);
+    double ax, ay;
+    to_world(B, c, sn, S0[0], S0[1], &ax, &ay);
+    S[0] = (real)ax, S[1] = (real)ay;
+    S[2] = (real)(c * S0[2] - sn * S0[3]), S[3] = (real)(sn * S0[2] + c * S0[3]);
+    S[4] = (real)(c * S0[4] - sn * S0[5]), S[5] = (real)(sn * S0[4] + c * S0[5]);
+  }
+  for (int k = b->nwallcirc; k < b->ncirc; k++) {
+    const real *C0 = b->circ0 + RHOD_CIRC_STRIDE * k;
+    real *C = b->circ + RHOD_CIRC_STRIDE * k;
+    const rhod_body_state *B = &bb->b[(int)C0[5]];
+    double cx, cy;
+    to_world(B, cos(B->q[2]), sin(B->q[2]), C0[0], C0[1], &cx, &cy);
+    C[0] = (real)cx, C[1] = (real)cy;
+  }
+  for (int k = 0; k < bb->n; k++) {
+    const rhod_body_state *B = &bb->b[k];
+    real *K = b->kin + RHOD_KIN_STRIDE * k;
+    K[0] = (real)(B->G0[0] + B->q[0]), K[1] = (real)(B->G0[1] + B->q[1]);
+    K[2] = (real)B->qd[0], K[3] = (real)B->qd[1], K[4] = (real)B->qd[2];
+    K[5] = (real)B->qdd[0], K[6] = (real)B->qdd[1], K[7] = (real)B->qdd[2];
+  }
+  rhod_to_device(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg);
+  rhod_to_device(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
+  rhod_to_device(b->kin, sizeof(real) * RHOD_KIN_STRIDE * (size_t)b->nbody);
+}
+
+void rhod_bodies_begin(rhod_bodies *bb) {
+  for (int k = 0; k < bb->n; k++) {
+    rhod_body_state *B = &bb->b[k];
+    for (int d = 0; d < RHOD_NDOF; d++) {
+      B->q0[d] = B->q[d], B->qd0[d] = B->qd[d];
+      B->kq[d] = 0, B->kqd[d] = 0;
+    }
+  }
+}
+
+void rhod_bodies_stage(rhod_bodies *bb, const rhod_rk_table *tab, int s, double t, double dt,
+                       const double gravity[2]) {
+  const int last = s == tab->stages - 1;
+  const double ts = last ? t + dt : t + tab->c[s] * dt; /* the next stage's time */
+  for (int k = 0; k < bb->n; k++) {
+    rhod_body_state *B = &bb->b[k];
+    const rhod_body *D = B->desc;
+    if (D->motion != RHOD_MOTION_FREE)
+      continue;
+    /* 2D rigid-body dynamics: M dU/dt = F + M g, I dOmega/dt = M_z (about the centre of
+     * mass G); dq/dt = (U, Omega) */
+    double a[RHOD_NDOF] = {B->F[0] / D->mass + gravity[0], B->F[1] / D->mass + gravity[1],
+                           B->F[2] / D->inertia};
+    for (int d = 0; d < RHOD_NDOF; d++) {
+      if (D->lock[d]) {
+        a[d] = 0;
+        continue; /* held exactly: q and its rate stay as they are */
+      }
+      const double kq = B->qd[d], kqd = a[d]; /* this stage's derivatives */
+      B->kq[d] += tab->w[s] * kq;
+      B->kqd[d] += tab->w[s] * kqd;
+      if (last) {
+        B->q[d] = B->q0[d] + dt / tab->div * B->kq[d];
+        B->qd[d] = B->qd0[d] + dt / tab->div * B->kqd[d];
+      } else {
+        B->q[d] = B->q0[d] + tab->c[s] * dt * kq;
+        B->qd[d] = B->qd0[d] + tab->c[s] * dt * kqd;
+      }
+    }
+    /* the next stage's ghost pressure uses this stage's acceleration (body.h) */
+    for (int d = 0; d < RHOD_NDOF; d++)
+      B->qdd[d] = a[d];
+  }
+  rhod_bodies_impose(bb, ts);
+}
+
+void rhod_bodies_values(const rhod_bodies *bb, double *out) {
+  for (int k = 0; k < bb->n; k++) {
+    const rhod_body_state *B = &bb->b[k];
+    double *o = out + RHOD_BODY_COLUMNS * k;
+    o[0] = B->F[0], o[1] = B->F[1], o[2] = B->F[2];
+    o[3] = B->G0[0] + B->q[0], o[4] = B->G0[1] + B->q[1], o[5] = B->q[2];
+    o[6] = B->qd[0], o[7] = B->qd[1], o[8] = B->qd[2];
+  }
+}
+
+int rhod_bodies_outline(const rhod_bodies *bb, double seg_len, unsigned **start, double **xy) {
+  *start = calloc((size_t)bb->n + 1, sizeof **start);
+  if (!*start)
+    return RHOD_ERR_MEMORY;
+  unsigned total = 0;
+  for (int k = 0; k < bb->n; k++) {
+    const rhod_shape *sh = &bb->b[k].desc->shape;
+    unsigned np = sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points;
+    if (sh->kind == RHOD_SHAPE_CIRCLE) {
+      const double m = ceil(2 * RHOD_PI * sh->radius / seg_len);
+      np = m < 16 ? 16 : (m > 1e6 ? 1000000 : (unsigned)m);
+    }
+    (*start)[k] = total;
+    total += np;
+  }
+  (*start)[bb->n] = total;
+  *xy = malloc(sizeof **xy * 2 * (total ? total : 1));
+  if (!*xy) {
+    free(*start);
+    *start = NULL;
+    return RHOD_ERR_MEMORY;
+  }
+  for (int k = 0; k < bb->n; k++) {
+    const rhod_body_state *B = &bb->b[k];
+    const rhod_shape *sh = &B->desc->shape;
+    const double c = cos(B->q[2]), s = sin(B->q[2]);
+    const unsigned a = (*start)[k], np = (*start)[k + 1] - a;
+    for (unsigned j = 0; j < np; j++) {
+      double x0, y0;
+      if (sh->kind == RHOD_SHAPE_RECT) {
+        x0 = (j == 0 || j == 3) ? sh->min[0] : sh->max[0];
+        y0 = j < 2 ? sh->min[1] : sh->max[1];
+      } else if (sh->kind == RHOD_SHAPE_POLYGON) {
+        x0 = sh->points[j][0], y0 = sh->points[j][1];
+      } else {
+        const double phi = 2 * RHOD_PI * j / np;
+        x0 = sh->center[0] + sh->radius * cos(phi), y0 = sh->center[1] + sh->radius * sin(phi);
+      }
+      to_world(B, c, s, x0, y0, &(*xy)[2 * (a + j)], &(*xy)[2 * (a + j) + 1]);
+    }
+  }
+  return RHOD_OK;
+}
+
+static void extra_name(int k, int e, char *buf, size_t len) {
+  static const char *const part[3] = {"q", "qd", "qdd"};
+  snprintf(buf, len, "body.%d.%s%d", k, part[e / RHOD_NDOF], e % RHOD_NDOF);
+}
+
+void rhod_bodies_save(const rhod_bodies *bb, rhod_checkpoint *ck) {
+  for (int k = 0; k < bb->n; k++) {
+    const rhod_body_state *B = &bb->b[k];
+    for (int e = 0; e < RHOD_BODY_EXTRAS && ck->nextra < RHOD_CK_MAX_EXTRAS; e++) {
+      const double *v = e < RHOD_NDOF ? B->q : (e < 2 * RHOD_NDOF ? B->qd : B->qdd);
+      extra_name(k, e, ck->extra_name[ck->nextra], sizeof ck->extra_name[0]);
+      ck->extra[ck->nextra++] = v[e % RHOD_NDOF];
+    }
+  }
+}
+
+int rhod_bodies_load(rhod_bodies *bb, rhod_boundary *b, const rhod_checkpoint *ck, char *err,
+                     size_t errlen) {
+  for (int k = 0; k < bb->n; k++) {
+    rhod_body_state *B = &bb->b[k];
+    for (int e = 0; e < RHOD_BODY_EXTRAS; e++) {
+      char name[32];
+      extra_name(k, e, name, sizeof name);
+      int i = 0;
+      while (i < ck->nextra && strcmp(ck->extra_name[i], name) != 0)
+        i++;
+      if (i == ck->nextra) {
+        snprintf(err, errlen, "the checkpoint has no %s (body %s)", name, B->desc->name);
+        return RHOD_ERR_CHECKPOINT;
+      }
+      double *v = e < RHOD_NDOF ? B->q : (e < 2 * RHOD_NDOF ? B->qd : B->qdd);
+      v[e % RHOD_NDOF] = ck->extra[i];
+    }
+  }
+  rhod_bodies_place(bb, b);
+  return RHOD_OK;
+}
