@@ -525,6 +525,9 @@ void rhod_sim_free(rhod_sim *s) {
     s->ops->free(s);
   rhod_cells_free(&s->cells);
   rhod_bodies_free(&s->bodies);
+  free(s->outline_start);
+  free(s->outline_xy);
+  s->outline_start = NULL, s->outline_xy = NULL;
   rhod_boundary_free(&s->bnd);
   /* the store frees the scheme's fields through pointers that live in its state: the
    * state goes last */
@@ -891,6 +894,18 @@ int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
         .u8 = fd->elem == 1,
         .comps = fd->elem == 2 * sizeof(real) ? 2 : 1,
     };
+  }
+  if (s->bodies.n > 0) { /* where the bodies stand (circles with segments of dx/4) */
+    free(s->outline_start);
+    free(s->outline_xy);
+    s->outline_start = NULL, s->outline_xy = NULL;
+    const int st = rhod_bodies_outline(&s->bodies, 0.25 * s->dx_min, &s->outline_start,
+                                       &s->outline_xy);
+    if (st != RHOD_OK)
+      return st;
+    v->n_bodies = (unsigned)s->bodies.n;
+    v->body_start = s->outline_start;
+    v->body_xy = s->outline_xy;
   }
   return RHOD_OK;
 }

@@ -34,6 +34,8 @@ typedef struct rhod_sim {
   rhod_boundary bnd;
   rhod_bodies bodies; /* the scene's bodies (body.h) */
   double body_mu;     /* the dynamic viscosity of the bodies' force (the scheme's; 0 inviscid) */
+  unsigned *outline_start; /* the bodies' outlines of the last rhod_sim_fetch */
+  double *outline_xy;
   rhod_cells cells;
   rhod_rk rk;          /* made with the scene's time.integrator; the scheme adds its variables */
   real **P, **V;       /* the scheme's pressure and volume over fluid and ghosts after
@@ -105,8 +107,9 @@ unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MA
 void rhod_probe_values(rhod_sim *s, double *values);
 
 /* Brings the fluid's output fields to the host and points a snapshot view at them
- * (valid until the next step), the scene's output.fields among the view's extras. Returns
- * RHOD_OK, or RHOD_ERR_MEMORY when the ghosts those fields need cannot be built. */
+ * (valid until the next step), the scene's output.fields among the view's extras and the
+ * bodies' outlines where they stand. Returns RHOD_OK, or RHOD_ERR_MEMORY when the ghosts
+ * those fields need or the outlines cannot be made. */
 int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v);
 
 /* The scheme's statistics and end-of-run lines (ops->stats, ops->report); none when the
