@@ -68,8 +68,9 @@ int rhod_snapshot_check(const rhod_snapshot_view *v, char *err, size_t errlen);
  * each body's closed polyline as line segments k -> k+1 and its last point -> its first;
  * S = P) and BodyIndex (S, uint32, "1": the body of each segment, its index in the scene's
  * bodies). The file is built in memory, then written through
- * rhod_write_bytes_atomic. Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"),
- * RHOD_ERR_MEMORY. */
+ * rhod_write_bytes_atomic. Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason",
+ * also for bodies' outlines that are incomplete: body_start or body_xy missing, body_start
+ * not from 0 or decreasing), RHOD_ERR_MEMORY. */
 int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
                         const rhod_param_list *params, char *err, size_t errlen);
 
@@ -171,7 +172,8 @@ int rhod_write_walls(const char *dir, const rhod_scene *sc, char *err, size_t er
  * NULL: automatic (rhod_picture_field_range). size_panel (ignored when the field is the
  * size): a second panel below, the same frame coloured by particle size.
  * rhod_picture_layout says where the frames are. Errors: RHOD_ERR_SCENE (empty frame,
- * picture side outside 1..16384), RHOD_ERR_IO (cannot write). */
+ * picture side outside 1..16384), RHOD_ERR_IO (cannot write; incomplete bodies' outlines,
+ * as rhod_write_snapshot). */
 int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
                        int size_panel, unsigned width, const double lo[2], const double hi[2],
                        const double *range, const rhod_wall *walls, unsigned n_walls, char *err,
