@@ -278,6 +278,63 @@ static int write_mesh(h5_reason *R, hid_t file, size_t n, void *buf) {
   return close_group(R, g, rc);
 }
 
+/* The bodies' points in all (P), when the view's outlines are complete: body_start from
+ * 0, never decreasing; (size_t)-1 when not. */
+static size_t body_points(const rhod_snapshot_view *v) {
+  if (v->n_bodies == 0)
+    return 0;
+  if (!v->body_start || v->body_start[0] != 0)
+    return (size_t)-1;
+  for (unsigned k = 0; k < v->n_bodies; k++)
+    if (v->body_start[k + 1] < v->body_start[k])
+      return (size_t)-1;
+  size_t np = v->body_start[v->n_bodies];
+  return np > 0 && !v->body_xy ? (size_t)-1 : np;
+}
+
+/* /Bodies (io.h): each body's outline, the closed polygon body_start[k] .. body_start[k +
+ * 1] - 1 of body_xy, as points and the line segments k -> k+1, last -> first (so S = P,
+ * the layout of walls.h5), the body of each segment and NumBodies. */
+static int write_bodies(h5_reason *R, hid_t file, const rhod_snapshot_view *v, size_t np,
+                        int *oom) {
+  double *pts = malloc(sizeof(double) * 3 * (np ? np : 1));
+  uint32_t *seg = malloc(sizeof(uint32_t) * 2 * (np ? np : 1));
+  uint32_t *bidx = malloc(sizeof(uint32_t) * (np ? np : 1));
+  int rc = -1;
+  if (!pts || !seg || !bidx) {
+    *oom = 1;
+    goto done;
+  }
+  for (unsigned b = 0; b < v->n_bodies; b++) {
+    const size_t s = v->body_start[b], m = v->body_start[b + 1] - s;
+    for (size_t k = 0; k < m; k++) {
+      pts[3 * (s + k)] = v->body_xy[2 * (s + k)];
+      pts[3 * (s + k) + 1] = v->body_xy[2 * (s + k) + 1];
+      pts[3 * (s + k) + 2] = 0.0;
+      seg[2 * (s + k)] = (uint32_t)(s + k);
+      seg[2 * (s + k) + 1] = (uint32_t)(s + (k + 1) % m);
+      bidx[s + k] = b;
+    }
+  }
+  hid_t g = create_group(R, file, "Bodies", H5P_DEFAULT);
+  if (g < 0)
+    goto done;
+  uint32_t nb = v->n_bodies;
+  rc = write_attr(R, g, "NumBodies", H5T_STD_U32LE, H5T_NATIVE_UINT32, &nb);
+  if (!rc)
+    rc = write_dataset(R, g, "Points", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, np, 3, pts, "m");
+  if (!rc)
+    rc = write_dataset(R, g, "Segments", H5T_STD_U32LE, H5T_NATIVE_UINT32, np, 2, seg, "1");
+  if (!rc)
+    rc = write_dataset(R, g, "BodyIndex", H5T_STD_U32LE, H5T_NATIVE_UINT32, np, 0, bidx, "1");
+  rc = close_group(R, g, rc);
+done:
+  free(pts);
+  free(seg);
+  free(bidx);
+  return rc;
+}
+
 static int write_header(h5_reason *R, hid_t file, const rhod_snapshot_view *v) {
   hid_t g = create_group(R, file, "Header", H5P_DEFAULT);
   if (g < 0)
@@ -421,6 +478,9 @@ static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_vie
   size_t increment = n * (6 * sizeof(double) + 4 * sizeof(double) + 9 + 8) + (1u << 16);
   for (unsigned k = 0; k < v->nextra; k++)
     increment += n * (v->extra[k].u8 ? 1 : 3 * sizeof(double));
+  const size_t nbp = body_points(v); /* checked by rhod_write_snapshot */
+  if (v->n_bodies)
+    increment += nbp * (3 * sizeof(double) + 3 * sizeof(uint32_t));
   hid_t file = core_file(R, name, increment);
   int bad = file < 0;
   if (!bad)
@@ -430,6 +490,8 @@ static void *build_image(h5_reason *R, const char *name, const rhod_snapshot_vie
   if (!bad)
     bad = write_mesh(R, file, n, buf) != 0;
   free(buf);
+  if (!bad && v->n_bodies)
+    bad = write_bodies(R, file, v, nbp, oom) != 0;
   if (!bad)
     bad = write_params(R, file, params, oom) != 0;
   if (file < 0)
@@ -459,6 +521,13 @@ int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
   if (v->nextra > RHOD_MAX_EXTRA_FIELDS) {
     set_err(err, errlen, "%s: cannot write: %u extra fields, more than %d", path, v->nextra,
             RHOD_MAX_EXTRA_FIELDS);
+    free(path);
+    return RHOD_ERR_IO;
+  }
+  const size_t nbp = body_points(v);
+  if (nbp == (size_t)-1 || nbp > UINT32_MAX) {
+    set_err(err, errlen, "%s: cannot write: the outlines of the %u bodies are incomplete", path,
+            v->n_bodies);
     free(path);
     return RHOD_ERR_IO;
   }
@@ -1097,6 +1166,132 @@ static int read_extras(reader *r, rhod_snapshot_data *out) {
   return rc;
 }
 
+/* /Bodies/name: rank 1 (cols 0) or rows x cols of a floating-point (flt) or unsigned integer
+ * type; *rows its length. -1 (error set) when missing or of another shape or type. */
+static hid_t open_body_dataset(reader *r, const char *name, unsigned cols, int flt, size_t *rows,
+                               int *rc) {
+  char full[64];
+  snprintf(full, sizeof full, "/Bodies/%s", name);
+  if (H5Lexists(r->file, full, H5P_DEFAULT) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen, "%s: missing dataset %s", r->path, full);
+    *rc = RHOD_ERR_READ;
+    return -1;
+  }
+  hid_t d = H5Dopen2(r->file, full, H5P_DEFAULT);
+  if (d < 0) {
+    *rc = rfail(r, full);
+    return -1;
+  }
+  hid_t sp = H5Dget_space(d), ft = H5Dget_type(d);
+  hsize_t dims[3] = {0, 0, 0};
+  const int rank = sp >= 0 ? H5Sget_simple_extent_ndims(sp) : -1;
+  if (rank >= 1 && rank <= 2)
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+  const H5T_class_t cl = ft >= 0 ? H5Tget_class(ft) : H5T_NO_CLASS;
+  const int type_ok = flt ? cl == H5T_FLOAT : cl == H5T_INTEGER && H5Tget_sign(ft) == H5T_SGN_NONE;
+  if (ft >= 0)
+    H5Tclose(ft);
+  if (sp >= 0)
+    H5Sclose(sp);
+  if (rank != (cols ? 2 : 1) || (cols && dims[1] != cols) || !type_ok ||
+      dims[0] > (hsize_t)UINT32_MAX) {
+    H5Eclear2(H5E_DEFAULT);
+    H5Dclose(d);
+    set_err(r->err, r->errlen, "%s: dataset %s is not %s%s", r->path, full,
+            flt ? "floating-point" : "unsigned integer",
+            cols == 3   ? ", P x 3"
+            : cols == 2 ? ", S x 2"
+                        : ", S");
+    *rc = RHOD_ERR_READ;
+    return -1;
+  }
+  *rows = (size_t)dims[0];
+  return d;
+}
+
+/* /Bodies when the file has it (older snapshots have none): NumBodies, Points, Segments,
+ * BodyIndex, checked against each other. */
+static int read_bodies(reader *r, rhod_snapshot_data *out) {
+  if (H5Lexists(r->file, "/Bodies", H5P_DEFAULT) <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    return RHOD_OK;
+  }
+  hid_t g = H5Gopen2(r->file, "/Bodies", H5P_DEFAULT);
+  if (g < 0)
+    return rfail(r, "/Bodies");
+  uint32_t nb = 0;
+  int rc = RHOD_OK;
+  if (H5Aexists(g, "NumBodies") <= 0) {
+    H5Eclear2(H5E_DEFAULT);
+    set_err(r->err, r->errlen, "%s: missing attribute /Bodies/NumBodies", r->path);
+    rc = RHOD_ERR_READ;
+  } else {
+    hid_t a = H5Aopen(g, "NumBodies", H5P_DEFAULT);
+    if (a < 0 || H5Aread(a, H5T_NATIVE_UINT32, &nb) < 0)
+      rc = rfail(r, "/Bodies/NumBodies");
+    if (a >= 0)
+      H5Aclose(a);
+  }
+  H5Gclose(g);
+  if (rc)
+    return rc;
+  size_t np = 0, ns = 0, ni = 0;
+  hid_t dp = open_body_dataset(r, "Points", 3, 1, &np, &rc);
+  hid_t ds = rc ? -1 : open_body_dataset(r, "Segments", 2, 0, &ns, &rc);
+  hid_t di = rc ? -1 : open_body_dataset(r, "BodyIndex", 0, 0, &ni, &rc);
+  if (!rc && ni != ns) {
+    set_err(r->err, r->errlen, "%s: /Bodies has %zu Segments and %zu BodyIndex values", r->path, ns,
+            ni);
+    rc = RHOD_ERR_READ;
+  }
+  double *pts = NULL;
+  if (!rc) {
+    pts = malloc(sizeof(double) * 3 * (np ? np : 1));
+    out->body_xy = malloc(sizeof(double) * 2 * (np ? np : 1));
+    out->body_segments = malloc(sizeof(uint32_t) * 2 * (ns ? ns : 1));
+    out->body_index = malloc(sizeof(uint32_t) * (ns ? ns : 1));
+    if (!pts || !out->body_xy || !out->body_segments || !out->body_index) {
+      set_err(r->err, r->errlen, "%s: out of memory reading /Bodies", r->path);
+      rc = RHOD_ERR_MEMORY;
+    }
+  }
+  if (!rc && np && H5Dread(dp, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, pts) < 0)
+    rc = rfail(r, "/Bodies/Points");
+  if (!rc && ns &&
+      H5Dread(ds, H5T_NATIVE_UINT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, out->body_segments) < 0)
+    rc = rfail(r, "/Bodies/Segments");
+  if (!rc && ns &&
+      H5Dread(di, H5T_NATIVE_UINT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, out->body_index) < 0)
+    rc = rfail(r, "/Bodies/BodyIndex");
+  for (size_t k = 0; !rc && k < np; k++)
+    out->body_xy[2 * k] = pts[3 * k], out->body_xy[2 * k + 1] = pts[3 * k + 1];
+  for (size_t k = 0; !rc && k < ns; k++)
+    if (out->body_segments[2 * k] >= np || out->body_segments[2 * k + 1] >= np ||
+        out->body_index[k] >= nb) {
+      set_err(r->err, r->errlen,
+              "%s: /Bodies segment %zu (%u, %u) of body %u is out of range (%zu points, %u "
+              "bodies)",
+              r->path, k, (unsigned)out->body_segments[2 * k],
+              (unsigned)out->body_segments[2 * k + 1], (unsigned)out->body_index[k], np,
+              (unsigned)nb);
+      rc = RHOD_ERR_READ;
+    }
+  free(pts);
+  if (dp >= 0)
+    H5Dclose(dp);
+  if (ds >= 0)
+    H5Dclose(ds);
+  if (di >= 0)
+    H5Dclose(di);
+  if (!rc) {
+    out->n_bodies = nb;
+    out->n_body_points = np;
+    out->n_body_segments = ns;
+  }
+  return rc;
+}
+
 static int read_all(reader *r, rhod_snapshot_data *out) {
   if (H5Lexists(r->file, "/Header", H5P_DEFAULT) <= 0) {
     H5Eclear2(H5E_DEFAULT);
@@ -1177,6 +1372,8 @@ static int read_all(reader *r, rhod_snapshot_data *out) {
     rc = read_extras(r, out);
   if (!rc)
     rc = read_params(r, &out->params);
+  if (!rc)
+    rc = read_bodies(r, out);
   return rc;
 }
 
@@ -1249,6 +1446,9 @@ void rhod_snapshot_data_free(rhod_snapshot_data *d) {
   }
   free(d->params.keys);
   free(d->params.values);
+  free(d->body_xy);
+  free(d->body_segments);
+  free(d->body_index);
   memset(d, 0, sizeof *d);
 }
 

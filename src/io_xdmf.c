@@ -9,7 +9,8 @@
  * cells and ParaView's default representation shows nothing. Attribute names are
  * singular (Velocity, Pressure, ...), their units those of the datasets' Units
  * attributes (docs/scene.md). Particle ids are declared as 8-byte Int, as SWIFT does,
- * which every XDMF reader maps. */
+ * which every XDMF reader maps. A run with bodies gets a second temporal collection, their
+ * outlines as Polyline grids at the snapshots' times (the layout of walls.xdmf). */
 #define _POSIX_C_SOURCE 200809L
 
 #include "rhod/io.h"
@@ -76,6 +77,27 @@ static void grid(FILE *f, int index, double time, size_t n, unsigned fields,
   fprintf(f, "      </Grid>\n");
 }
 
+/* One snapshot's bodies (io_hdf5.c, write_bodies): np points, as many segments. */
+static void body_grid(FILE *f, int index, double time, size_t np) {
+  char file[64];
+  snprintf(file, sizeof file, "snapshot_%04d.h5", index);
+  fprintf(f, "      <Grid Name=\"bodies_%04d\" GridType=\"Uniform\">\n", index);
+  fprintf(f, "        <Time Value=\"%.15g\"/>\n", time);
+  fprintf(f,
+          "        <Topology TopologyType=\"Polyline\" NumberOfElements=\"%zu\" "
+          "NodesPerElement=\"2\">\n",
+          np);
+  data_item(f, file, "/Bodies/Segments", np, 2, "UInt", 4);
+  fprintf(f, "        </Topology>\n");
+  fprintf(f, "        <Geometry GeometryType=\"XYZ\">\n");
+  data_item(f, file, "/Bodies/Points", np, 3, "Float", 8);
+  fprintf(f, "        </Geometry>\n");
+  fprintf(f, "        <Attribute Name=\"BodyIndex\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
+  data_item(f, file, "/Bodies/BodyIndex", np, 0, "UInt", 4);
+  fprintf(f, "        </Attribute>\n");
+  fprintf(f, "      </Grid>\n");
+}
+
 int rhod_write_xdmf(const char *dir, int count, const double *times, const size_t *nparts,
                     unsigned fields, char *err, size_t errlen) {
   return rhod_write_xdmf_fields(dir, count, times, nparts, fields, NULL, 0, err, errlen);
@@ -84,6 +106,12 @@ int rhod_write_xdmf(const char *dir, int count, const double *times, const size_
 int rhod_write_xdmf_fields(const char *dir, int count, const double *times, const size_t *nparts,
                            unsigned fields, const rhod_snapshot_extra *extra, unsigned nextra,
                            char *err, size_t errlen) {
+  return rhod_write_xdmf_bodies(dir, count, times, nparts, fields, extra, nextra, 0, err, errlen);
+}
+
+int rhod_write_xdmf_bodies(const char *dir, int count, const double *times, const size_t *nparts,
+                           unsigned fields, const rhod_snapshot_extra *extra, unsigned nextra,
+                           size_t body_points, char *err, size_t errlen) {
   size_t dl = dir ? strlen(dir) : 0;
   const char *name = "snapshots.xdmf";
   char *path = malloc(dl + strlen(name) + 2);
@@ -109,8 +137,16 @@ int rhod_write_xdmf_fields(const char *dir, int count, const double *times, cons
   fprintf(f, "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
              "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
              "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
-             "  <Domain>\n"
-             "    <Grid Name=\"particles\" GridType=\"Collection\" "
+             "  <Domain>\n");
+  if (body_points > 0) {
+    /* the bodies first: meshio's time-series reader takes the domain's last collection */
+    fprintf(f, "    <Grid Name=\"bodies\" GridType=\"Collection\" "
+               "CollectionType=\"Temporal\">\n");
+    for (int i = 0; i < count; i++)
+      body_grid(f, i, times[i], body_points);
+    fprintf(f, "    </Grid>\n");
+  }
+  fprintf(f, "    <Grid Name=\"particles\" GridType=\"Collection\" "
              "CollectionType=\"Temporal\">\n");
   for (int i = 0; i < count; i++)
     grid(f, i, times[i], nparts[i], fields, extra, nextra);

@@ -431,8 +431,11 @@ static int write_output(run_ctx *c, char *err, size_t len) {
   c->snap_t[c->nsnap] = s->t;
   c->snap_n[c->nsnap] = s->p.n;
   c->nsnap++;
-  st = rhod_write_xdmf_fields(c->out, c->nsnap, c->snap_t, c->snap_n, rhod_snapshot_fields(&v),
-                              v.extra, v.nextra, err, len);
+  /* the bodies' outlines keep their point counts through a run: this snapshot's serve
+   * for the earlier ones (a resume included) */
+  st = rhod_write_xdmf_bodies(c->out, c->nsnap, c->snap_t, c->snap_n, rhod_snapshot_fields(&v),
+                              v.extra, v.nextra, v.n_bodies ? v.body_start[v.n_bodies] : 0, err,
+                              len);
   if (st != RHOD_OK)
     return st;
   const rhod_scene *sc = c->sc;

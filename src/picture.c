@@ -1,6 +1,8 @@
 /* PNG pictures of one particle field: each particle a filled disc of its own size in the
  * frame [lo, hi] (y up), coloured by viridis; the walls as dark 2-pixel lines inside the
- * frame; axes with tick labels in metres along the frame's left and bottom edges; below
+ * frame; the bodies filled light grey under the particles (a body's interior shows as
+ * such where no particle covers it) and outlined like the walls over them; axes with tick
+ * labels in metres along the frame's left and bottom edges; below
  * them a strip with the colour bar, its range, the field's name and unit and the time, in
  * a built-in 5x7 bitmap font. Optionally a second panel below, the same frame coloured by
  * particle size (log scale). Encoded by libpng (simplified API, into memory) and written
@@ -444,6 +446,19 @@ static void thick_segment(canvas *f, unsigned fw, unsigned fh, double p[2][2]) {
   }
 }
 
+/* The closed polygon pts[0 .. n - 1] (metres) as 2-pixel lines in the frame [lo, hi]. */
+static void draw_ring(canvas *f, unsigned fw, unsigned fh, const double lo[2], const double hi[2],
+                      const double (*pts)[2], size_t n) {
+  const double sx = fw / (hi[0] - lo[0]), sy = fh / (hi[1] - lo[1]);
+  for (size_t k = 0; k < n; k++) {
+    const double *a = pts[k], *b = pts[(k + 1) % n];
+    double p[2][2] = {{(a[0] - lo[0]) * sx, (hi[1] - a[1]) * sy},
+                      {(b[0] - lo[0]) * sx, (hi[1] - b[1]) * sy}};
+    if (isfinite(p[0][0]) && isfinite(p[0][1]) && isfinite(p[1][0]) && isfinite(p[1][1]))
+      thick_segment(f, fw, fh, p);
+  }
+}
+
 static void draw_walls(canvas *f, unsigned fw, unsigned fh, const double lo[2], const double hi[2],
                        const rhod_wall *walls, unsigned n_walls) {
   const double sx = fw / (hi[0] - lo[0]), sy = fh / (hi[1] - lo[1]);
@@ -457,14 +472,81 @@ static void draw_walls(canvas *f, unsigned fw, unsigned fh, const double lo[2], 
     if (!pts)
       continue; /* out of memory: the picture without this wall */
     rhod_shape_outline(sh, segs, pts);
-    for (unsigned k = 0; k < n; k++) {
-      const double *a = pts[k], *b = pts[(k + 1) % n];
-      double p[2][2] = {{(a[0] - lo[0]) * sx, (hi[1] - a[1]) * sy},
-                        {(b[0] - lo[0]) * sx, (hi[1] - b[1]) * sy}};
-      if (isfinite(p[0][0]) && isfinite(p[0][1]) && isfinite(p[1][0]) && isfinite(p[1][1]))
-        thick_segment(f, fw, fh, p);
-    }
+    draw_ring(f, fw, fh, lo, hi, (const double(*)[2])pts, n);
     free(pts);
+  }
+}
+
+/* ------------------------------------------------------------ bodies */
+
+static const unsigned char body_fill[3] = {220, 220, 220};
+
+/* Body k's outline: its points in view->body_xy (x, y interleaved). */
+static const double (*body_ring(const rhod_snapshot_view *v, unsigned k, size_t *n))[2] {
+  *n = v->body_start[k + 1] - v->body_start[k];
+  return (const double(*)[2])(v->body_xy + 2 * (size_t)v->body_start[k]);
+}
+
+/* Fills each body's polygon light grey (even-odd rule, pixel centres), under the
+ * particles: a row's crossings with the edges, sorted, pair by pair. -1: out of memory. */
+static int fill_bodies(canvas *f, unsigned fw, unsigned fh, const double lo[2], const double hi[2],
+                       const rhod_snapshot_view *v) {
+  const double sx = fw / (hi[0] - lo[0]), sy = fh / (hi[1] - lo[1]);
+  for (unsigned b = 0; b < v->n_bodies; b++) {
+    size_t n;
+    const double(*pts)[2] = body_ring(v, b, &n);
+    if (n < 3)
+      continue;
+    double *px = malloc(sizeof(double) * 3 * n);
+    if (!px)
+      return -1;
+    double *py = px + n, *cross = px + 2 * n;
+    double ymin = INFINITY, ymax = -INFINITY;
+    int finite = 1;
+    for (size_t k = 0; k < n; k++) {
+      px[k] = (pts[k][0] - lo[0]) * sx;
+      py[k] = (hi[1] - pts[k][1]) * sy;
+      finite &= isfinite(px[k]) && isfinite(py[k]);
+      ymin = fmin(ymin, py[k]);
+      ymax = fmax(ymax, py[k]);
+    }
+    /* clamped before the casts: the rows and columns inside the frame */
+    long j0 = finite ? (long)fmin(fmax(floor(ymin - 0.5), 0.0), fh) : 0;
+    long j1 = finite ? (long)fmin(fmax(ceil(ymax), -1.0), (double)fh - 1) : -1;
+    for (long j = j0; j <= j1; j++) {
+      const double yc = j + 0.5;
+      size_t nc = 0;
+      for (size_t k = 0; k < n; k++) {
+        const size_t l = (k + 1) % n;
+        if ((py[k] <= yc) != (py[l] <= yc)) {
+          double x = px[k] + (yc - py[k]) * (px[l] - px[k]) / (py[l] - py[k]);
+          size_t at = nc++; /* insertion sort: a row crosses an outline a few times */
+          while (at > 0 && cross[at - 1] > x) {
+            cross[at] = cross[at - 1];
+            at--;
+          }
+          cross[at] = x;
+        }
+      }
+      for (size_t c = 0; c + 1 < nc; c += 2) {
+        /* the pixels whose centres lie in [cross[c], cross[c + 1]) */
+        double a = fmin(fmax(ceil(cross[c] - 0.5), 0.0), fw);
+        double e = fmin(fmax(ceil(cross[c + 1] - 0.5), 0.0), fw);
+        for (long i = (long)a; i < (long)e; i++)
+          put(f, i, j, body_fill);
+      }
+    }
+    free(px);
+  }
+  return 0;
+}
+
+static void draw_bodies(canvas *f, unsigned fw, unsigned fh, const double lo[2], const double hi[2],
+                        const rhod_snapshot_view *v) {
+  for (unsigned b = 0; b < v->n_bodies; b++) {
+    size_t n;
+    const double(*pts)[2] = body_ring(v, b, &n);
+    draw_ring(f, fw, fh, lo, hi, pts, n);
   }
 }
 
@@ -545,6 +627,10 @@ static int draw_panel(canvas *c, long y_off, const layout *L, unsigned width,
   canvas f = {rows, width, fh};
   const double ex = hi[0] - lo[0], ey = hi[1] - lo[1], sx = width / ex, sy = fh / ey;
   static const unsigned char grey[3] = {160, 160, 160};
+  if (fill_bodies(&f, width, fh, lo, hi, v) != 0) {
+    free(rows);
+    return -1;
+  }
   for (size_t i = 0; i < v->n; i++) {
     double cx = ((double)v->x[i] - lo[0]) * sx, cy = (hi[1] - (double)v->y[i]) * sy;
     if (!isfinite(cx) || !isfinite(cy))
@@ -565,6 +651,7 @@ static int draw_panel(canvas *c, long y_off, const layout *L, unsigned width,
     disc(&f, fh, cx, cy, r, rgb);
   }
   draw_walls(&f, width, fh, lo, hi, walls, n_walls);
+  draw_bodies(&f, width, fh, lo, hi, v);
   for (unsigned j = 0; j < fh; j++)
     memcpy(c->px + 3 * ((size_t)(y0 + j) * c->w + (size_t)x0), rows + (size_t)3 * width * j,
            (size_t)3 * width);
@@ -641,6 +728,15 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
   }
   if (!walls)
     n_walls = 0;
+  int bodies_ok = v->n_bodies == 0 || (v->body_start && v->body_start[0] == 0);
+  for (unsigned k = 0; bodies_ok && k < v->n_bodies; k++)
+    bodies_ok = v->body_start[k + 1] >= v->body_start[k];
+  if (!bodies_ok || (v->n_bodies && v->body_start[v->n_bodies] && !v->body_xy)) {
+    if (err && errlen)
+      snprintf(err, errlen, "%s: cannot draw: the outlines of the %u bodies are incomplete", path,
+               v->n_bodies);
+    return RHOD_ERR_IO;
+  }
 
   /* Layout (make_layout): per panel, a top margin, the frame with the axes at its left
    * and bottom, the colour bar strip; with the size panel (paper 002 Figs. 11, 17, 19

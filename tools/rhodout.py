@@ -25,7 +25,9 @@ def snapshots(out):
 
 
 def read_snapshot(path):
-    """Dict of numpy arrays (sorted by particle id) plus 'time'."""
+    """Dict of numpy arrays (sorted by particle id) plus 'time'; with bodies also 'bodies':
+    one (m, 2) array per body (its index in the scene's bodies), its outline's points in
+    order where it stands at that time (the closed polygon of /Bodies)."""
     with h5py.File(path, "r") as f:
         g = f["PartType0"]
         ids = g["ParticleIDs"][()]
@@ -36,6 +38,13 @@ def read_snapshot(path):
         for key, name in (("rho", "Densities"), ("p", "Pressures"), ("m", "Masses"),
                           ("size", "ParticleSizes")):
             d[key] = g[name][()][order]
+        if "Bodies" in f:
+            b = f["Bodies"]
+            pts, seg = b["Points"][()][:, :2], b["Segments"][()]
+            index = b["BodyIndex"][()]
+            # each body's segments run k -> k+1 and close back: their first points in order
+            d["bodies"] = [pts[seg[index == k, 0]]
+                           for k in range(int(b.attrs["NumBodies"]))]
     return d
 
 

@@ -62,13 +62,20 @@ int rhod_snapshot_check(const rhod_snapshot_view *v, char *err, size_t errlen);
  * the view's extra datasets (v->extra, in order) with their units: real ones as double, N or
  * N x 3 (z = 0), uint8 ones as uint8. /Header
  * also carries the strings Code ("rhod"), Precision (RHOD_REAL_NAME), CodeVersion (rhod_version())
- * and GitCommit (rhod_commit()). The file is built in memory, then written through
- * rhod_write_bytes_atomic. Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason"),
- * RHOD_ERR_MEMORY. */
+ * and GitCommit (rhod_commit()). When the view has bodies (n_bodies > 0), a group /Bodies
+ * with the attribute NumBodies (n_bodies) and the datasets Points (P x 3, z = 0, "m": the
+ * outlines' points in order, body after body), Segments (S x 2 point indices, uint32, "1":
+ * each body's closed polyline as line segments k -> k+1 and its last point -> its first;
+ * S = P) and BodyIndex (S, uint32, "1": the body of each segment, its index in the scene's
+ * bodies). The file is built in memory, then written through
+ * rhod_write_bytes_atomic. Errors: RHOD_ERR_IO ("OUT/snapshot_NNNN.h5: cannot write: reason",
+ * also for bodies' outlines that are incomplete: body_start or body_xy missing, body_start
+ * not from 0 or decreasing), RHOD_ERR_MEMORY. */
 int rhod_write_snapshot(const char *dir, int index, const rhod_snapshot_view *v,
                         const rhod_param_list *params, char *err, size_t errlen);
 
-/* Reads a snapshot written by rhod_write_snapshot (arrays malloc'd, double). Errors:
+/* Reads a snapshot written by rhod_write_snapshot (arrays malloc'd, double), /Bodies when
+ * the file has it (a segment's point or body index out of range is an error). Errors:
  * RHOD_ERR_READ (missing or unreadable file, missing dataset or attribute, wrong shape),
  * RHOD_ERR_MEMORY; out is then empty. rhod_snapshot_data_free accepts an emptied one. */
 /* An extra dataset read back: every /PartType0 dataset rhod_write_snapshot does not write
@@ -93,6 +100,12 @@ typedef struct {
   rhod_param_list params; /* /Parameters (Keys and Values; in older files the attributes)
                              in file order; owned here, freed by
                              rhod_snapshot_data_free (not rhod_param_list_free) */
+  /* /Bodies as written (all 0 and NULL when the file has none): NumBodies, the Points
+   * (x, y interleaved, z dropped), the Segments (2 point indices each) and BodyIndex */
+  unsigned n_bodies;
+  size_t n_body_points, n_body_segments;
+  double *body_xy;
+  uint32_t *body_segments, *body_index;
 } rhod_snapshot_data;
 int rhod_read_snapshot(const char *path, rhod_snapshot_data *out, char *err, size_t errlen);
 void rhod_snapshot_data_free(rhod_snapshot_data *d);
@@ -121,6 +134,16 @@ int rhod_write_xdmf(const char *dir, int count, const double *times, const size_
 int rhod_write_xdmf_fields(const char *dir, int count, const double *times, const size_t *nparts,
                            unsigned fields, const rhod_snapshot_extra *extra, unsigned nextra,
                            char *err, size_t errlen);
+/* The same with the bodies' outlines: body_points > 0 (the bodies' points, and segments,
+ * of every snapshot: a run's bodies keep their outlines) puts before the particles'
+ * collection a second temporal collection "bodies", for each snapshot a Uniform grid at
+ * the same time with Topology Polyline (2 nodes per element, /Bodies/Segments), Geometry
+ * XYZ (/Bodies/Points) and the cell attribute BodyIndex; the particles' collection stays
+ * the last grid of the domain (meshio's time-series reader reads the last collection).
+ * body_points 0: the file of rhod_write_xdmf_fields, byte for byte. */
+int rhod_write_xdmf_bodies(const char *dir, int count, const double *times, const size_t *nparts,
+                           unsigned fields, const rhod_snapshot_extra *extra, unsigned nextra,
+                           size_t body_points, char *err, size_t errlen);
 
 /* The closed outline of a shape as a polygon: a rect's 4 corners, a polygon's points,
  * a circle as `circle_segments` points (at least 8). out (may be NULL: count only) holds
@@ -141,13 +164,16 @@ int rhod_write_walls(const char *dir, const rhod_scene *sc, char *err, size_t er
 /* A PNG picture of one field: each particle a disc of its own size, coloured by a
  * perceptual colour map (particle size: on a log scale); the frame is the box [lo, hi],
  * `width` pixels wide (its height keeps the aspect ratio); the walls (n_walls of them,
- * may be NULL when 0) drawn as dark 2-pixel lines inside the frame; axes with tick labels
+ * may be NULL when 0) drawn as dark 2-pixel lines inside the frame; the view's bodies
+ * filled light grey (220, 220, 220) under the particles and their outlines drawn as
+ * dark 2-pixel lines (as the walls) over them, in every panel; axes with tick labels
  * in metres along the frame's left and bottom edges ("x [m]", "y [m]"); below, a colour
  * bar with its range, the field's name and unit (e.g. "p [Pa]") and the time. range
  * NULL: automatic (rhod_picture_field_range). size_panel (ignored when the field is the
  * size): a second panel below, the same frame coloured by particle size.
  * rhod_picture_layout says where the frames are. Errors: RHOD_ERR_SCENE (empty frame,
- * picture side outside 1..16384), RHOD_ERR_IO (cannot write). */
+ * picture side outside 1..16384), RHOD_ERR_IO (cannot write; incomplete bodies' outlines,
+ * as rhod_write_snapshot). */
 int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field field,
                        int size_panel, unsigned width, const double lo[2], const double hi[2],
                        const double *range, const rhod_wall *walls, unsigned n_walls, char *err,
