@@ -503,3 +503,52 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
   }
   return count;
 }
+
+long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *body) {
+  *body = -1;
+  if (b->nbody == 0)
+    return -1;
+  const int s0 = b->nwallseg, s1 = b->nseg, c0 = b->nwallcirc, c1 = b->ncirc;
+  const real *seg = b->seg, *circ = b->circ, *x = p->x, *y = p->y, *dx = p->dx;
+  const long n = (long)p->n;
+  long bad = n;
+  RHOD_KERNEL_LOOP_REDUCE(min, bad)
+  for (long i = 0; i < n; i++) {
+    const real lim = (real)0.5 * dx[i];
+    /* the nearest body segment decides the side (its normal points into the fluid) */
+    real best = -1, sd = 0;
+    for (int s = s0; s < s1; s++) {
+      const real *S = seg + RHOD_SEG_STRIDE * s;
+      const real e2 = seg_dist2(S, x[i], y[i]);
+      if (best < 0 || e2 < best)
+        best = e2, sd = S[2] * (x[i] - S[0]) + S[3] * (y[i] - S[1]);
+    }
+    int in = best >= 0 && sd < 0 && best > lim * lim;
+    for (int c = c0; c < c1; c++) {
+      const real *C = circ + RHOD_CIRC_STRIDE * c;
+      const real rx = x[i] - C[0], ry = y[i] - C[1];
+      in |= sqrt(rx * rx + ry * ry) < C[2] - lim;
+    }
+    if (in && i < bad)
+      bad = i;
+  }
+  if (bad == n)
+    return -1;
+  /* which body (host side, one particle) */
+  real xb = 0, yb = 0;
+  rhod_to_host(p->x + bad, sizeof(real));
+  rhod_to_host(p->y + bad, sizeof(real));
+  xb = p->x[bad], yb = p->y[bad];
+  double best = HUGE_VAL;
+  for (int s = s0; s < s1; s++) {
+    const double e2 = seg_dist2(b->seg + RHOD_SEG_STRIDE * s, xb, yb);
+    if (e2 < best)
+      best = e2, *body = (int)b->seg[RHOD_SEG_STRIDE * s + 10];
+  }
+  for (int c = c0; c < c1; c++) {
+    const real *C = b->circ + RHOD_CIRC_STRIDE * c;
+    if (hypot(xb - C[0], yb - C[1]) < C[2])
+      *body = (int)C[5];
+  }
+  return bad;
+}

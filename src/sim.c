@@ -609,8 +609,21 @@ static int check_state(rhod_sim *s, char *err, size_t errlen) {
     if (!(finite && inside) && i < bad)
       bad = i;
   }
-  if (bad == n)
-    return RHOD_OK;
+  if (bad == n) {
+    /* a particle deep inside a body: the body overtook it or it went through (stops the
+     * run: its ghosts would be wrong from now on) */
+    int body;
+    const long e = rhod_bodies_entered(&s->bnd, p, &body);
+    if (e < 0)
+      return RHOD_OK;
+    rhod_to_host(p->id + e, sizeof(uint64_t));
+    snprintf(err, errlen,
+             "unstable at t = %.6g s (step %ld): particle id %llu entered body %s (more than "
+             "half its size inside, at x = %g, y = %g)",
+             s->t, s->step, (unsigned long long)p->id[e],
+             body >= 0 ? s->sc->bodies[body].name : "?", (double)p->x[e], (double)p->y[e]);
+    return RHOD_ERR_UNSTABLE;
+  }
   real v[5];
   rhod_to_host(p->x + bad, sizeof(real));
   rhod_to_host(p->y + bad, sizeof(real));
@@ -899,8 +912,8 @@ int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
     free(s->outline_start);
     free(s->outline_xy);
     s->outline_start = NULL, s->outline_xy = NULL;
-    const int st = rhod_bodies_outline(&s->bodies, 0.25 * s->dx_min, &s->outline_start,
-                                       &s->outline_xy);
+    const int st =
+        rhod_bodies_outline(&s->bodies, 0.25 * s->dx_min, &s->outline_start, &s->outline_xy);
     if (st != RHOD_OK)
       return st;
     v->n_bodies = (unsigned)s->bodies.n;

@@ -77,6 +77,10 @@ void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real radiu
  * returns how many. */
 long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p);
 
+/* The first fluid particle that lies more than half its size inside a body (past what the
+ * wall guard puts back), or -1; *body its body's index. Host-side result of a device loop. */
+long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *body);
+
 /* A point moved off the walls: where (x, y) lies less than `keep` in front of a wall
  * (or behind it, by less than `back`), with its foot on the wall, it moves along the
  * wall normal to stand `keep` in front; walls in order, segments then circles. For
