@@ -926,6 +926,34 @@ cleanup:
 
 /* ---- rhod check ----------------------------------------------------------------------- */
 
+/* One line per body: its motion, shape and resolved values (src/scene_bodies.c). */
+static void print_bodies(const rhod_scene *sc) {
+  static const char *const motion[] = {"fixed", "imposed", "free"}, *const dof[] = {"x", "y",
+                                                                                    "theta"};
+  static const char *const shape[] = {"rect", "polygon", "circle"};
+  for (unsigned i = 0; i < sc->n_bodies; i++) {
+    const rhod_body *b = &sc->bodies[i];
+    printf("body %s (bodies.%u): %s %s, centre [%g, %g], slip %s, refinement near it %s", b->name,
+           i, motion[b->motion], shape[b->shape.kind], b->center[0], b->center[1],
+           b->slip == RHOD_SLIP_NO ? "no" : "free", b->refine ? "on" : "off");
+    if (b->motion == RHOD_MOTION_IMPOSED)
+      printf(", at t = 0 moved by [%g, %g] m and turned by %g rad", b->pose0[0], b->pose0[1],
+             b->pose0[2]);
+    if (b->motion == RHOD_MOTION_FREE) {
+      printf(", mass %g kg/m", b->mass);
+      if (b->density > 0)
+        printf(" (density %g kg/m^3)", b->density);
+      printf(", inertia %g kg m, locked:", b->inertia);
+      int any = 0;
+      for (int k = 0; k < RHOD_NDOF; k++)
+        if (b->lock[k])
+          printf(" %s", dof[k]), any = 1;
+      printf("%s", any ? "" : " none");
+    }
+    printf("\n");
+  }
+}
+
 static int check_scene(run_opts *o) {
   char err[ERRLEN] = "";
   rhod_scene *sc = NULL;
@@ -969,6 +997,7 @@ static int check_scene(run_opts *o) {
          ceil(steps), sc->t_end);
   printf("outputs: %.0f snapshots, %.0f probe rows\n", floor(sc->t_end / sc->output_every) + 1,
          floor(sc->t_end / sc->probe_every) + 1);
+  print_bodies(sc);
   if (nw > 0) {
     char *line = strtok(warn, "\n");
     while (line) {

@@ -110,6 +110,8 @@ typedef struct {
   char *law[RHOD_NDOF];    /* imposed: bodies.N.law.{x, y, theta}: G's displacement [m] and
                               the rotation about G [rad, counter-clockwise] as expressions of
                               t [s] (libmatheval syntax); NULL where not given (0) */
+  double pose0[RHOD_NDOF]; /* where the body stands at t = 0: the law's x, y [m] and theta
+                              [rad] at t = 0 (imposed; 0 otherwise), resolved by the loader */
   double mass;             /* free: per unit depth [kg/m] (bodies.N.mass, or density x area) */
   double density;          /* free: bodies.N.density [kg/m^3] as given, 0 when mass was */
   double inertia;          /* free: moment of inertia about G per unit depth [kg m]
