@@ -64,8 +64,8 @@ static const char *HELP_RESUME =
 static const char *HELP_CHECK =
     "usage: rhod check SCENE [--set=KEY=VALUE]...\n"
     "Loads and validates the scene, builds the initial particles and prints their count,\n"
-    "the memory they need, the first time step and an estimate of the number of steps.\n"
-    "Writes nothing.\n"
+    "the memory they need, the first time step, an estimate of the number of steps and\n"
+    "one line per body (its motion and resolved centre, mass, inertia). Writes nothing.\n"
     "  -h, --help   this text\n";
 
 /* ---- terminal output ------------------------------------------------------------------ */

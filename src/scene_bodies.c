@@ -256,20 +256,157 @@ static const char *motion_word(rhod_motion_kind m) {
   return rhod_sl_enum_name(motion_names, CYAML_ARRAY_LEN(motion_names), (int)m);
 }
 
+/* ---- the laws' syntax ------------------------------------------------------------------- */
+
+/* libmatheval's parser leaks its nodes on a syntax error and its scanner echoes a character
+ * it has no rule for to stdout, so a law is parsed here first, by libmatheval's grammar
+ * (GNU libmatheval 1.1: expression ::= NUMBER | CONSTANT | VARIABLE | FUNCTION ( expr ) |
+ * ( expr ) | - expr | expr {+ - * / ^} expr; its scanner's longest match), and handed to
+ * evaluator_create only when it parses. */
+static const char *const law_functions[] = {
+    "exp",   "log",   "sqrt",  "sin",  "cos",  "tan",   "cot",      "sec",
+    "csc",   "asin",  "acos",  "atan", "acot", "asec",  "acsc",     "sinh",
+    "cosh",  "tanh",  "coth",  "sech", "csch", "asinh", "acosh",    "atanh",
+    "acoth", "asech", "acsch", "abs",  "step", "delta", "nandelta", "erf"};
+/* the constants whose names start with a digit (the others scan as identifiers) */
+static const char *const law_digit_constants[] = {"1_pi", "2_pi", "2_sqrtpi"};
+#define LAW_MAX_LEN 1000 /* characters of a law */
+#define LAW_MAX_DEPTH 64 /* nested parentheses */
+
+enum { TK_END, TK_ATOM, TK_FUNC, TK_OP, TK_MINUS, TK_LP, TK_RP, TK_BAD };
+
+static size_t digits(const char *p) {
+  size_t n = 0;
+  while (p[n] >= '0' && p[n] <= '9')
+    n++;
+  return n;
+}
+
+static int ident_char(char ch, int first) {
+  return ch == '_' || (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+         (!first && ch >= '0' && ch <= '9');
+}
+
+/* The token at text[*i] (spaces and tabs skipped; *at its start), *i moved past it. */
+static int law_token(const char *s, size_t *i, size_t *at) {
+  while (s[*i] == ' ' || s[*i] == '\t')
+    (*i)++;
+  *at = *i;
+  const char *p = s + *i;
+  if (!*p)
+    return TK_END;
+  if ((*p >= '0' && *p <= '9') || *p == '.') {
+    /* number: {d}+ | {d}+.{d}* | {d}*.{d}+, then ([Ee][+-]?{d}+)? */
+    size_t n = digits(p), len = n;
+    if (p[n] == '.') {
+      const size_t m = digits(p + n + 1);
+      len = n || m ? n + 1 + m : 0;
+    }
+    if (len && (p[len] == 'e' || p[len] == 'E')) {
+      size_t j = len + 1 + (p[len + 1] == '+' || p[len + 1] == '-');
+      if (digits(p + j))
+        len = j + digits(p + j);
+    }
+    for (size_t k = 0; k < sizeof law_digit_constants / sizeof law_digit_constants[0]; k++) {
+      const size_t cl = strlen(law_digit_constants[k]);
+      if (cl > len && strncmp(p, law_digit_constants[k], cl) == 0)
+        len = cl;
+    }
+    *i += len;
+    return len ? TK_ATOM : TK_BAD;
+  }
+  if (ident_char(*p, 1)) {
+    size_t n = 1;
+    while (ident_char(p[n], 0))
+      n++;
+    *i += n;
+    for (size_t k = 0; k < sizeof law_functions / sizeof law_functions[0]; k++)
+      if (strlen(law_functions[k]) == n && strncmp(p, law_functions[k], n) == 0)
+        return TK_FUNC;
+    return TK_ATOM; /* a constant or a variable */
+  }
+  (*i)++;
+  switch (*p) {
+  case '+':
+  case '*':
+  case '/':
+  case '^':
+    return TK_OP;
+  case '-':
+    return TK_MINUS;
+  case '(':
+    return TK_LP;
+  case ')':
+    return TK_RP;
+  default:
+    return TK_BAD;
+  }
+}
+
+/* expr ::= unary ({+ - * / ^} unary)*, unary ::= -* primary, primary ::= ATOM |
+ * FUNC ( expr ) | ( expr ). Returns 1 when it parses; else 0 with *bad the offending
+ * token's offset. */
+static int law_expr(const char *s, size_t *i, int depth, size_t *bad) {
+  size_t at;
+  for (;;) {
+    int tk;
+    while ((tk = law_token(s, i, &at)) == TK_MINUS)
+      ;
+    if (tk == TK_FUNC) {
+      tk = law_token(s, i, &at);
+      if (tk != TK_LP)
+        return *bad = at, 0;
+    }
+    if (tk == TK_LP) {
+      if (depth >= LAW_MAX_DEPTH || !law_expr(s, i, depth + 1, bad))
+        return depth >= LAW_MAX_DEPTH ? (*bad = at, 0) : 0;
+      if (law_token(s, i, &at) != TK_RP)
+        return *bad = at, 0;
+    } else if (tk != TK_ATOM) {
+      return *bad = at, 0;
+    }
+    const size_t before = *i;
+    tk = law_token(s, i, &at);
+    if (tk != TK_OP && tk != TK_MINUS) {
+      *i = before; /* the caller's token */
+      return 1;
+    }
+  }
+}
+
+/* Whether text parses as libmatheval would parse it; else *bad is where it stops. */
+static int law_parses(const char *text, size_t *bad) {
+  size_t i = 0, at;
+  if (!law_expr(text, &i, 0, bad))
+    return 0;
+  if (law_token(text, &i, &at) != TK_END)
+    return *bad = at, 0;
+  return 1;
+}
+
 /* bodies.N.law.K: an expression of t alone (libmatheval), whose value, first and second
  * derivatives are finite at t = 0; *v0 its value there. */
 static int check_law(lctx *c, const char *path, const char *text, double *v0) {
   const int cut = strlen(text) > 80;
+  if (strlen(text) > LAW_MAX_LEN)
+    return rhod_sl_fail(c, path, "longer than %d characters", LAW_MAX_LEN);
+  size_t bad = 0;
+  if (!law_parses(text, &bad)) {
+    char near[16];
+    snprintf(near, sizeof near, "%.8s", text + bad);
+    return rhod_sl_fail(c, path,
+                        "'%.80s%s' is not an expression of t (libmatheval syntax, e.g. "
+                        "0.1*sin(2*pi*t)): %s%s%s at character %zu",
+                        text, cut ? "..." : "", near[0] ? "unexpected '" : "it ends early", near,
+                        near[0] ? "'" : "", bad + 1);
+  }
   char *copy = strdup(text);
   if (!copy)
     return rhod_sl_fail_oom(c);
   void *ev = evaluator_create(copy);
   free(copy);
-  if (!ev)
-    return rhod_sl_fail(c, path,
-                        "'%.80s%s' is not an expression (libmatheval syntax, of t, e.g. "
-                        "0.1*sin(2*pi*t))",
-                        text, cut ? "..." : "");
+  if (!ev) /* parsed above: only when out of memory */
+    return rhod_sl_fail(c, path, "'%.80s%s': libmatheval cannot read it", text, cut ? "..." : "");
   char **names = NULL;
   int count = 0;
   evaluator_get_variables(ev, &names, &count);
