@@ -173,7 +173,7 @@ typedef struct {
                               a fraction of dx in [0, 0.5], default 0 */
   /* physics: */
   double gravity[2]; /* physics.gravity [m/s^2], default [0, 0] */
-  /* domain (default: the bounding box of walls and fluid): */
+  /* domain (default: the bounding box of walls, fluid and bodies at t = 0): */
   int has_domain;
   double domain_min[2], domain_max[2];
   int periodic[2]; /* domain.periodic: [false, false] */
