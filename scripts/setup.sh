@@ -2,7 +2,7 @@
 # Installs the Debian packages rhod needs when they are missing (run as root on a
 # fresh Debian 12 machine; a no-op when everything is there).
 set -euo pipefail
-PKGS=(build-essential cmake clang-format valgrind python3 pkg-config libhdf5-dev libcunit1-dev libcyaml-dev libpng-dev
+PKGS=(build-essential cmake clang-format valgrind python3 pkg-config libhdf5-dev libcunit1-dev libcyaml-dev libmatheval-dev libpng-dev
       gcc-12-offload-nvptx libjansson-dev python3-meshio python3-numpy python3-h5py python3-matplotlib python3-scipy hdf5-tools)
 missing=()
 for p in "${PKGS[@]}"; do

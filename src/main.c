@@ -64,8 +64,8 @@ static const char *HELP_RESUME =
 static const char *HELP_CHECK =
     "usage: rhod check SCENE [--set=KEY=VALUE]...\n"
     "Loads and validates the scene, builds the initial particles and prints their count,\n"
-    "the memory they need, the first time step and an estimate of the number of steps.\n"
-    "Writes nothing.\n"
+    "the memory they need, the first time step, an estimate of the number of steps and\n"
+    "one line per body (its motion and resolved centre, mass, inertia). Writes nothing.\n"
     "  -h, --help   this text\n";
 
 /* ---- terminal output ------------------------------------------------------------------ */
@@ -938,6 +938,34 @@ cleanup:
 
 /* ---- rhod check ----------------------------------------------------------------------- */
 
+/* One line per body: its motion, shape and resolved values (src/scene_bodies.c). */
+static void print_bodies(const rhod_scene *sc) {
+  static const char *const motion[] = {"fixed", "imposed", "free"}, *const dof[] = {"x", "y",
+                                                                                    "theta"};
+  static const char *const shape[] = {"rect", "polygon", "circle"};
+  for (unsigned i = 0; i < sc->n_bodies; i++) {
+    const rhod_body *b = &sc->bodies[i];
+    printf("body %s (bodies.%u): %s %s, centre [%g, %g], slip %s, refinement near it %s", b->name,
+           i, motion[b->motion], shape[b->shape.kind], b->center[0], b->center[1],
+           b->slip == RHOD_SLIP_NO ? "no" : "free", b->refine ? "on" : "off");
+    if (b->motion == RHOD_MOTION_IMPOSED)
+      printf(", at t = 0 moved by [%g, %g] m and turned by %g rad", b->pose0[0], b->pose0[1],
+             b->pose0[2]);
+    if (b->motion == RHOD_MOTION_FREE) {
+      printf(", mass %g kg/m", b->mass);
+      if (b->density > 0)
+        printf(" (density %g kg/m^3)", b->density);
+      printf(", inertia %g kg m, locked:", b->inertia);
+      int any = 0;
+      for (int k = 0; k < RHOD_NDOF; k++)
+        if (b->lock[k])
+          printf(" %s", dof[k]), any = 1;
+      printf("%s", any ? "" : " none");
+    }
+    printf("\n");
+  }
+}
+
 static int check_scene(run_opts *o) {
   char err[ERRLEN] = "";
   rhod_scene *sc = NULL;
@@ -981,6 +1009,7 @@ static int check_scene(run_opts *o) {
          ceil(steps), sc->t_end);
   printf("outputs: %.0f snapshots, %.0f probe rows\n", floor(sc->t_end / sc->output_every) + 1,
          floor(sc->t_end / sc->probe_every) + 1);
+  print_bodies(sc);
   if (nw > 0) {
     char *line = strtok(warn, "\n");
     while (line) {

@@ -15,6 +15,7 @@
 
 #include "multiphase/scene_mp.h"
 #include "rhodsph/scene_rs.h"
+#include "scene_bodies.h"
 #include "scene_module.h"
 #include "scene_yaml.h"
 
@@ -174,6 +175,8 @@ typedef struct {
   unsigned n_fluid;
   y_wall *walls;
   unsigned n_walls;
+  y_body *bodies; /* src/scene_bodies.c */
+  unsigned n_bodies;
   y_probes *probes;
   y_output *output;
   y_rs_refinement *refinement; /* the rhodsph scheme's section (src/rhodsph/scene_rs.c) */
@@ -423,6 +426,8 @@ static const cyaml_schema_field_t f_doc[] = {
     CYAML_FIELD_SEQUENCE_COUNT("fluid", CYAML_FLAG_POINTER, y_doc, fluid, n_fluid, &sch_fluid, 1,
                                CYAML_UNLIMITED),
     CYAML_FIELD_SEQUENCE_COUNT("walls", OPT, y_doc, walls, n_walls, &sch_wall, 0, CYAML_UNLIMITED),
+    CYAML_FIELD_SEQUENCE_COUNT("bodies", OPT, y_doc, bodies, n_bodies, &rhod_bd_sch_body, 0,
+                               CYAML_UNLIMITED),
     CYAML_FIELD_MAPPING_PTR("probes", OPT, y_doc, probes, f_probes),
     CYAML_FIELD_MAPPING_PTR("output", OPT, y_doc, output, f_output),
     CYAML_FIELD_MAPPING_PTR("refinement", OPT, y_doc, refinement, rhod_rs_f_refinement),
@@ -1096,6 +1101,10 @@ static int segments_meet(const double *a, const double *b, const double *p, cons
     return 1;
   return (d1 == 0 && on_segment(p, q, a)) || (d2 == 0 && on_segment(p, q, b)) ||
          (d3 == 0 && on_segment(a, b, p)) || (d4 == 0 && on_segment(a, b, q));
+}
+
+int rhod_sl_segments_meet(const double *a, const double *b, const double *p, const double *q) {
+  return segments_meet(a, b, p, q);
 }
 
 void rhod_sl_shape_bbox(const rhod_shape *sh, double lo[2], double hi[2]) {
@@ -1790,15 +1799,22 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     w->fluid_inside = opt_bool(y->fluid_inside, 1);
     TRY(load_wall_motion(c, y, i, w, s->periodic));
   }
+  /* bodies (src/scene_bodies.c): after the domain and the walls, which they are checked
+   * against */
+  TRY(rhod_bd_load(c, d->bodies, d->n_bodies, s));
   /* refinement (paper 002 Sec. V) */
   if (!mpx)
     TRY(rhod_rs_load_refinement(c, d->refinement, s));
-  /* the default domain: bounding box of walls and fluid */
+  /* the default domain: bounding box of walls, fluid and the bodies where they stand at
+   * t = 0 */
   if (!s->has_domain) {
-    for (unsigned i = 0; i < s->n_fluid + s->n_walls; i++) {
-      const rhod_shape *sh = i < s->n_fluid ? &s->fluid[i].shape : &s->walls[i - s->n_fluid].shape;
+    for (unsigned i = 0; i < s->n_fluid + s->n_walls + s->n_bodies; i++) {
       double lo[2], hi[2];
-      rhod_sl_shape_bbox(sh, lo, hi);
+      if (i < s->n_fluid + s->n_walls)
+        rhod_sl_shape_bbox(i < s->n_fluid ? &s->fluid[i].shape : &s->walls[i - s->n_fluid].shape,
+                           lo, hi);
+      else
+        rhod_bd_bbox(&s->bodies[i - s->n_fluid - s->n_walls], lo, hi);
       for (int a = 0; a < 2; a++) {
         s->domain_min[a] = i ? fmin(s->domain_min[a], lo[a]) : lo[a];
         s->domain_max[a] = i ? fmax(s->domain_max[a], hi[a]) : hi[a];
@@ -2152,6 +2168,7 @@ static ry_node *scene_tree(const rhod_scene *s) {
           tb_num(&t, edges, NULL, k);
     }
   }
+  rhod_bd_tree(&t, root, s);
   m = tb_coll(&t, root, "probes", RY_MAP, 0);
   tb_num(&t, m, "every", s->probe_every);
   m = tb_coll(&t, m, "list", RY_SEQ, s->n_probes == 0);
@@ -2211,6 +2228,7 @@ void rhod_scene_free(rhod_scene *s) {
     free(s->walls[i].shape.points);
   for (unsigned i = 0; i < s->n_probes; i++)
     free(s->probes[i].name);
+  rhod_bd_free(s);
   rhod_rs_scene_free(s->rs);
   rhod_mp_scene_free(s->mp);
   free(s->fluid);

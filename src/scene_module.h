@@ -71,6 +71,8 @@ int rhod_sl_load_shape(lctx *c, const char *base, const y_rect *rect, const y_ci
 /* A shape's bounding box and area. */
 void rhod_sl_shape_bbox(const rhod_shape *sh, double lo[2], double hi[2]);
 double rhod_sl_shape_area(const rhod_shape *sh);
+/* Whether segments a-b and p-q meet (cross or touch). */
+int rhod_sl_segments_meet(const double *a, const double *b, const double *p, const double *q);
 /* Whether a string is a valid identifier: [A-Za-z_][A-Za-z0-9_]*, at most 64 characters. */
 int rhod_sl_identifier(const char *s);
 

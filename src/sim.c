@@ -31,6 +31,17 @@ static int in_shape(const rhod_shape *sh, double x, double y) {
 
 int rhod_shape_contains(const rhod_shape *sh, double x, double y) { return in_shape(sh, x, y); }
 
+/* Whether (x, y) lies in body B (or on its outline) where it stands at t = 0: the point
+ * taken back to the body at zero displacement, x0 = G + R(-theta0) (x - G - d0), with d0 and
+ * theta0 the law's values at t = 0 (rhod_body.pose0; 0 unless imposed). */
+static int in_body0(const rhod_body *B, double x, double y) {
+  const double *d = B->pose0, *G = B->center;
+  if (d[0] == 0 && d[1] == 0 && d[2] == 0)
+    return in_shape(&B->shape, x, y);
+  const double rx = x - G[0] - d[0], ry = y - G[1] - d[1], c = cos(d[2]), sn = sin(d[2]);
+  return in_shape(&B->shape, G[0] + c * rx + sn * ry, G[1] - sn * rx + c * ry);
+}
+
 static void shape_box(const rhod_shape *sh, double lo[2], double hi[2]) {
   if (sh->kind == RHOD_SHAPE_RECT) {
     for (int a = 0; a < 2; a++)
@@ -114,6 +125,9 @@ int rhod_sim_block_at(const rhod_sim *s, double x, double y) {
     return -1;
   if (s->bnd.nseg + s->bnd.ncirc > 0 && rhod_wall_distance(&s->bnd, x, y) <= 0)
     return -1;
+  for (unsigned k = 0; k < sc->n_bodies; k++) /* a body's interior at t = 0 stays empty */
+    if (in_body0(&sc->bodies[k], x, y))
+      return -1;
   for (unsigned b = 0; b < sc->n_fluid; b++) /* a point of an earlier block is not filled twice */
     if (in_shape(&sc->fluid[b].shape, x, y))
       return (int)b;
@@ -186,6 +200,13 @@ static void count_dropped(rhod_sim *s, unsigned b, double x, double y) {
       f->container = f->container < 0 ? (int)w : f->container;
       return;
     }
+  for (unsigned k = 0; k < sc->n_bodies; k++)
+    if (in_body0(&sc->bodies[k], x, y)) {
+      f->in_body++;
+      f->body = f->body < 0 ? (int)k : f->body;
+      f->bodies_more |= f->body != (int)k;
+      return;
+    }
   f->on_wall++;
 }
 
@@ -229,6 +250,9 @@ static void block_dropped(const rhod_fill_stats *f, char *buf, size_t len) {
              f->container);
   if (f->in_obstacle)
     DROP_PUT("%s%zu inside the obstacle walls.%d", used ? ", " : "", f->in_obstacle, f->obstacle);
+  if (f->in_body)
+    DROP_PUT("%s%zu inside the body bodies.%d%s", used ? ", " : "", f->in_body, f->body,
+             f->bodies_more ? " and others" : "");
   if (f->out_domain)
     DROP_PUT("%s%zu outside the domain", used ? ", " : "", f->out_domain);
   if (f->on_wall)
@@ -239,7 +263,8 @@ static void block_dropped(const rhod_fill_stats *f, char *buf, size_t len) {
 /* Why block b holds no particle, for the "no particle fits" error. */
 static void block_empty_why(const rhod_sim *s, unsigned b, char *buf, size_t len) {
   const rhod_fill_stats *f = &s->fill[b];
-  const size_t dropped = f->out_container + f->in_obstacle + f->out_domain + f->on_wall;
+  const size_t dropped =
+      f->out_container + f->in_obstacle + f->in_body + f->out_domain + f->on_wall;
   if (dropped) {
     char causes[512];
     block_dropped(f, causes, sizeof causes);
@@ -429,7 +454,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     return RHOD_ERR_MEMORY;
   }
   for (unsigned b = 0; b < sc->n_fluid; b++)
-    s->fill[b].obstacle = s->fill[b].container = -1;
+    s->fill[b].obstacle = s->fill[b].container = s->fill[b].body = -1;
   if (sc->has_domain) {
     for (int a = 0; a < 2; a++)
       s->lo[a] = sc->domain_min[a], s->hi[a] = sc->domain_max[a];
@@ -962,7 +987,8 @@ int rhod_sim_warnings(rhod_sim *s, char *buf, size_t len) {
   /* fluid left out of its block by walls or the domain */
   for (unsigned b = 0; s->fill && b < sc->n_fluid; b++) {
     const rhod_fill_stats *f = &s->fill[b];
-    const size_t dropped = f->out_container + f->in_obstacle + f->out_domain + f->on_wall;
+    const size_t dropped =
+        f->out_container + f->in_obstacle + f->in_body + f->out_domain + f->on_wall;
     if (!dropped)
       continue;
     char where[512], causes[512];

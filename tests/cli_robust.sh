@@ -117,6 +117,21 @@ expect 0 "rhod run OUT/scene.yaml" -- "$RHOD" run "$T/again/scene.yaml" -o "$T/r
 check "the repeated run's probes are the same" -- cmp "$T/again/probes.csv" "$T/repeat/probes.csv"
 check "the repeated run's last snapshot is the same" -- \
   cmp "$T/again/snapshot_0002.png" "$T/repeat/snapshot_0002.png"
+# bodies (issue 51): --set on a body, the scene as run reads back to the same scene
+BODIES=$SRC/tests/scenes/good/bodies.yaml
+BSHORT=(--set time.end=0.002 --set time.output_every=0.001 --set bodies.0.slip=no
+        --set "bodies.2.law.x=0.01*sin(t)")
+expect 0 "bodies: a run" -- "$RHOD" run "$BODIES" -o "$T/bodies" "${BSHORT[@]}"
+check "bodies: --set applied" -- grep -q 'x: 0.01\*sin(t)' "$T/bodies/scene.yaml"
+expect 0 "bodies: rhod run OUT/scene.yaml" -- "$RHOD" run "$T/bodies/scene.yaml" -o "$T/bodies2"
+check "bodies: the scene as run reads back identically" -- \
+  cmp <(tail -n +2 "$T/bodies/scene.yaml") <(tail -n +2 "$T/bodies2/scene.yaml")
+check "bodies: the same probes" -- cmp "$T/bodies/probes.csv" "$T/bodies2/probes.csv"
+expect 0 "bodies: rhod check" -- "$RHOD" check "$BODIES"
+check "bodies: check prints each body" -- \
+  grep -q "body tri (bodies.1): free polygon, centre \[1.1, 0.333333\].*mass 30 kg/m (density 500 kg/m^3), inertia 0.416667 kg m, locked: x theta" "$T/stdout"
+check "bodies: check names the fluid left inside them" -- \
+  grep -q "left out: 358 inside the body bodies.0 and others" "$T/stdout"
 
 # 53.6 the command line
 expect 0 "rhod help" -- "$RHOD" help

@@ -110,6 +110,8 @@ typedef struct {
   char *law[RHOD_NDOF];    /* imposed: bodies.N.law.{x, y, theta}: G's displacement [m] and
                               the rotation about G [rad, counter-clockwise] as expressions of
                               t [s] (libmatheval syntax); NULL where not given (0) */
+  double pose0[RHOD_NDOF]; /* where the body stands at t = 0: the law's x, y [m] and theta
+                              [rad] at t = 0 (imposed; 0 otherwise), resolved by the loader */
   double mass;             /* free: per unit depth [kg/m] (bodies.N.mass, or density x area) */
   double density;          /* free: bodies.N.density [kg/m^3] as given, 0 when mass was */
   double inertia;          /* free: moment of inertia about G per unit depth [kg m]
@@ -175,7 +177,7 @@ typedef struct {
                               a fraction of dx in [0, 0.5], default 0 */
   /* physics: */
   double gravity[2]; /* physics.gravity [m/s^2], default [0, 0] */
-  /* domain (default: the bounding box of walls and fluid): */
+  /* domain (default: the bounding box of walls, fluid and bodies at t = 0): */
   int has_domain;
   double domain_min[2], domain_max[2];
   int periodic[2]; /* domain.periodic: [false, false] */

@@ -21,8 +21,11 @@ typedef struct {
   size_t out_domain;       /* outside the domain box */
   size_t in_obstacle;      /* inside an obstacle (walls.N with fluid_inside: false) */
   size_t out_container;    /* outside a container (walls.N with fluid_inside: true) */
+  size_t in_body;          /* inside a body (bodies.N) where it stands at t = 0 */
   size_t on_wall;          /* on or just behind a wall otherwise */
   int obstacle, container; /* the first such wall's index, -1 if none */
+  int body;                /* the first such body's index, -1 if none */
+  int bodies_more;         /* points inside other bodies than that too */
 } rhod_fill_stats;
 
 typedef struct rhod_sim {
@@ -57,7 +60,8 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen);
 void rhod_sim_free(rhod_sim *s);
 
 /* For schemes. The fluid block that owns (x, y): the first whose shape holds it, if it is
- * fluid (inside the domain, not behind a wall); -1 otherwise. */
+ * fluid (inside the domain, not behind a wall, not in a body where it stands at t = 0); -1
+ * otherwise. */
 int rhod_sim_block_at(const rhod_sim *s, double x, double y);
 /* Whether (x, y) lies in the shape (its boundary included; a polygon by the even-odd
  * rule), as the fill tests it. */
