@@ -1,17 +1,15 @@
-/* The fluid's force and moment on rigid bodies (body.h): a gather over the bodies' ghosts,
- * then a reduction per body. */
+/* The fluid's force and moment on rigid bodies (body.h): the pressure integrated over the
+ * boundary, and the viscous pair term gathered over the bodies' ghosts, reduced per body. */
 #include "rhod/body.h"
 #include "rhod/kernel.h"
+#include "rhod/shepard.h"
 #include <math.h>
 #include <stdlib.h>
 
-int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
-                       real ratio, const real *P, const real *V, real mu) {
+/* The viscous part (body.h): per ghost of a body, its pair sum over the fluid. */
+static int viscous(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
+                   real ratio, const real *V, real mu) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
-  for (int k = 0; k < bb->n; k++)
-    bb->b[k].F[0] = bb->b[k].F[1] = bb->b[k].F[2] = 0;
-  if (bb->n == 0 || nt == n || !p->gbody)
-    return RHOD_OK;
   const size_t need = (size_t)(nt - n);
   if (need > bb->fghost_cap) {
     rhod_dev_free(bb->fghost, sizeof(real) * 2 * bb->fghost_cap);
@@ -37,7 +35,7 @@ int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cell
   for (long g = n; g < nt; g++) {
     real fx = 0, fy = 0;
     if (gbody[g] >= 0) {
-      const real xj = x[g], yj = y[g], Pj = P[g], Vj = V[g], uxj = ux[g], uyj = uy[g];
+      const real xj = x[g], yj = y[g], Vj = V[g], uxj = ux[g], uyj = uy[g];
       RHOD_FOR_NEIGHBOURS(G, CS, CI, xj, yj, Rmax, i) {
         /* the fluid and its periodic images (gbody -2): each pair once, from the body's
          * own ghosts (their periodic images carry -1) */
@@ -48,10 +46,10 @@ int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cell
             const real r = sqrt(r2);
             /* grad_i W_ij = dW/dr (x_i - x_j)/r, with i's radius */
             const real dWr = rhod_dW(kern, r, Ri) / r;
-            /* Bouscasse et al. 2013 (paper 002 Ref. 8) pair form, d = 2:
-             * [(P_i + P_j) - 2 (d + 2) mu pi_ij] grad_i W_ij V_i V_j */
+            /* Bouscasse et al. 2013 (paper 002 Ref. 8), d = 2: -2 (d + 2) mu pi_ij grad_i W_ij
+             * V_i V_j, the reaction of paper 002 Eq. 10's force on i */
             const real pij = ((ux[i] - uxj) * rx + (uy[i] - uyj) * ry) / r2;
-            const real a = ((P[i] + Pj) - 8 * mu * pij) * dWr * V[i] * Vj;
+            const real a = -8 * mu * pij * dWr * V[i] * Vj;
             fx += a * rx;
             fy += a * ry;
           }
@@ -74,7 +72,42 @@ int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cell
     for (long g = n; g < nt; g++)
       if (gbody[g] == k)
         Mz += (x[g] - Gx) * f[2 * (g - n) + 1] - (y[g] - Gy) * f[2 * (g - n)];
-    B->F[0] = Fx, B->F[1] = Fy, B->F[2] = Mz;
+    B->F[0] += Fx, B->F[1] += Fy, B->F[2] += Mz;
   }
+  return RHOD_OK;
+}
+
+int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
+                       real ratio, const real *P, const real *V, real mu) {
+  for (int k = 0; k < bb->n; k++)
+    bb->b[k].F[0] = bb->b[k].F[1] = bb->b[k].F[2] = 0;
+  if (bb->n == 0)
+    return RHOD_OK;
+  /* the quadrature points where the bodies stand, and the pressure there */
+  const int ns = bb->ns;
+  for (int q = 0; q < ns; q++) {
+    const rhod_body_state *B = &bb->b[bb->sb[q]];
+    const double cs = cos(B->q[2]), sn = sin(B->q[2]);
+    const double rx = bb->x0[q] - B->G0[0], ry = bb->y0[q] - B->G0[1];
+    bb->px[q] = (real)(B->G0[0] + B->q[0] + cs * rx - sn * ry);
+    bb->py[q] = (real)(B->G0[1] + B->q[1] + sn * rx + cs * ry);
+  }
+  rhod_to_device(bb->px, sizeof(real) * (size_t)ns);
+  rhod_to_device(bb->py, sizeof(real) * (size_t)ns);
+  rhod_shepard(c, kern, ratio, p->x, p->y, p->dx, V, P, ns, bb->px, bb->py, bb->fp, bb->gam);
+  rhod_to_host(bb->fp, sizeof(real) * (size_t)ns);
+  rhod_to_host(bb->gam, sizeof(real) * (size_t)ns);
+  for (int q = 0; q < ns; q++) {
+    rhod_body_state *B = &bb->b[bb->sb[q]];
+    const double cs = cos(B->q[2]), sn = sin(B->q[2]);
+    const double nx = cs * bb->nx0[q] - sn * bb->ny0[q], ny = sn * bb->nx0[q] + cs * bb->ny0[q];
+    /* -P n dS, n out of the body; a dry point (Gamma < 0.1, as the pressure probes) adds 0 */
+    const double Pq = bb->gam[q] > (real)0.1 ? (double)bb->fp[q] : 0.0;
+    const double fx = -Pq * nx * bb->ds[q], fy = -Pq * ny * bb->ds[q];
+    const double rx = bb->px[q] - (B->G0[0] + B->q[0]), ry = bb->py[q] - (B->G0[1] + B->q[1]);
+    B->F[0] += fx, B->F[1] += fy, B->F[2] += rx * fy - ry * fx;
+  }
+  if (mu > 0 && p->gbody && p->ng > 0)
+    return viscous(bb, p, c, kern, ratio, V, mu);
   return RHOD_OK;
 }

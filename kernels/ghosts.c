@@ -193,8 +193,15 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       if (C[4] != 0) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
       } else {
-        for (int k = 0; k < 4; k++)
-          Tn[k] = Jn[k];
+        /* free slip on a curved wall: no shear stress is d(u_t/r)/dr = 0, so the mirror
+         * keeps u_t/r, u_t' = (r_g/r_s) u_t, and reverses u_n: T = k (I - e e^T) - e e^T,
+         * k = r_g/r_s (docs/choices.md "bodies"; the plain mirror J, k = 1, let the first
+         * rows around a circle at rest start a growing oscillation) */
+        const real k = rg / dist;
+        Tn[0] = k - (1 + k) * ex * ex;
+        Tn[1] = -(1 + k) * ex * ey;
+        Tn[2] = Tn[1];
+        Tn[3] = k - (1 + k) * ey * ey;
       }
       const int body = (int)C[5];
       if (body >= 0)

@@ -45,8 +45,47 @@ void rhod_bodies_impose(rhod_bodies *bb, double t) {
   }
 }
 
-int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, double t, char *err,
-                     size_t errlen) {
+/* The quadrature points of the boundary of shape sh (at zero displacement), at most ds
+ * apart, into bb from index *q (count only when bb->x0 is NULL). */
+static void shape_samples(rhod_bodies *bb, int body, const rhod_shape *sh, double ds, int *q) {
+  if (sh->kind == RHOD_SHAPE_CIRCLE) {
+    const int m = (int)fmax(16, ceil(2 * RHOD_PI * sh->radius / ds));
+    for (int k = 0; k < m; k++, (*q)++)
+      if (bb->x0) {
+        const double phi = 2 * RHOD_PI * (k + 0.5) / m;
+        bb->nx0[*q] = cos(phi), bb->ny0[*q] = sin(phi);
+        bb->x0[*q] = sh->center[0] + sh->radius * cos(phi);
+        bb->y0[*q] = sh->center[1] + sh->radius * sin(phi);
+        bb->ds[*q] = 2 * RHOD_PI * sh->radius / m;
+        bb->sb[*q] = body;
+      }
+    return;
+  }
+  const double rect[4][2] = {{sh->min[0], sh->min[1]},
+                             {sh->max[0], sh->min[1]},
+                             {sh->max[0], sh->max[1]},
+                             {sh->min[0], sh->max[1]}};
+  const unsigned np = sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points;
+  const double(*pt)[2] = sh->kind == RHOD_SHAPE_RECT ? rect : (const double(*)[2])sh->points;
+  for (unsigned e = 0; e < np; e++) {
+    const double *a = pt[e], *c = pt[(e + 1) % np];
+    const double tx = c[0] - a[0], ty = c[1] - a[1], len = hypot(tx, ty);
+    const int m = (int)fmax(1, ceil(len / ds));
+    for (int k = 0; k < m; k++, (*q)++)
+      if (bb->x0) {
+        const double f = (k + 0.5) / m;
+        /* counter-clockwise (the loader stores polygons so): the outward normal is the
+         * edge's right-hand one */
+        bb->nx0[*q] = ty / len, bb->ny0[*q] = -tx / len;
+        bb->x0[*q] = a[0] + f * tx, bb->y0[*q] = a[1] + f * ty;
+        bb->ds[*q] = len / m;
+        bb->sb[*q] = body;
+      }
+  }
+}
+
+int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, double t, double ds,
+                     char *err, size_t errlen) {
   memset(bb, 0, sizeof *bb);
   if (sc->n_bodies == 0)
     return RHOD_OK;
@@ -84,6 +123,27 @@ int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, do
       B->qd[2] = D->lock[2] ? 0 : D->omega;
     }
   }
+  /* the pressure's quadrature points */
+  int q = 0;
+  for (int k = 0; k < bb->n; k++)
+    shape_samples(bb, k, &sc->bodies[k].shape, ds, &q);
+  bb->ns = q;
+  const size_t nq = (size_t)q;
+  bb->x0 = malloc(sizeof(double) * nq), bb->y0 = malloc(sizeof(double) * nq);
+  bb->nx0 = malloc(sizeof(double) * nq), bb->ny0 = malloc(sizeof(double) * nq);
+  bb->ds = malloc(sizeof(double) * nq), bb->sb = malloc(sizeof(int) * nq);
+  bb->px = malloc(sizeof(real) * nq), bb->py = malloc(sizeof(real) * nq);
+  bb->fp = malloc(sizeof(real) * nq), bb->gam = malloc(sizeof(real) * nq);
+  if (!bb->x0 || !bb->y0 || !bb->nx0 || !bb->ny0 || !bb->ds || !bb->sb || !bb->px || !bb->py ||
+      !bb->fp || !bb->gam)
+    return RHOD_ERR_MEMORY;
+  q = 0;
+  for (int k = 0; k < bb->n; k++)
+    shape_samples(bb, k, &sc->bodies[k].shape, ds, &q);
+  rhod_dev_map(bb->px, sizeof(real) * nq);
+  rhod_dev_map(bb->py, sizeof(real) * nq);
+  rhod_dev_map(bb->fp, sizeof(real) * nq);
+  rhod_dev_map(bb->gam, sizeof(real) * nq);
   rhod_bodies_impose(bb, t);
   rhod_bodies_place(bb, b);
   return RHOD_OK;
@@ -97,6 +157,15 @@ void rhod_bodies_free(rhod_bodies *bb) {
           evaluator_destroy(bb->b[k].law[d][o]);
   free(bb->b);
   rhod_dev_free(bb->fghost, sizeof(real) * 2 * bb->fghost_cap);
+  if (bb->px) {
+    const size_t nq = (size_t)bb->ns;
+    rhod_dev_unmap(bb->px, sizeof(real) * nq);
+    rhod_dev_unmap(bb->py, sizeof(real) * nq);
+    rhod_dev_unmap(bb->fp, sizeof(real) * nq);
+    rhod_dev_unmap(bb->gam, sizeof(real) * nq);
+  }
+  free(bb->x0), free(bb->y0), free(bb->nx0), free(bb->ny0), free(bb->ds), free(bb->sb);
+  free(bb->px), free(bb->py), free(bb->fp), free(bb->gam);
   memset(bb, 0, sizeof *bb);
 }
 

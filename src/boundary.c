@@ -181,3 +181,19 @@ double rhod_wall_distance(const rhod_boundary *b, double x, double y) {
   }
   return best;
 }
+
+double rhod_body_distance(const rhod_boundary *b, double x, double y) {
+  double best = HUGE_VAL;
+  for (int s = b->nwallseg; s < b->nseg; s++) {
+    const real *S = b->seg + RHOD_SEG_STRIDE * s;
+    const double rx = x - S[0], ry = y - S[1];
+    double t = rx * S[4] + ry * S[5];
+    t = t < 0 ? 0 : (t > S[6] ? S[6] : t);
+    best = fmin(best, hypot(rx - t * S[4], ry - t * S[5]));
+  }
+  for (int c = b->nwallcirc; c < b->ncirc; c++) {
+    const real *C = b->circ + RHOD_CIRC_STRIDE * c;
+    best = fmin(best, fabs(hypot(x - C[0], y - C[1]) - C[2]));
+  }
+  return best;
+}

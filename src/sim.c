@@ -219,6 +219,14 @@ static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t 
       count_dropped(s, b, x, y);
     return;
   }
+  /* not within half a size of a body: a particle nearer than that would nearly coincide
+   * with its own mirror (docs/choices.md "bodies: fill"); the walls' lattices stand dx/2
+   * off them by construction */
+  if (s->bnd.nbody > 0 && rhod_body_distance(&s->bnd, x, y) < 0.5 * dx) {
+    if (!write)
+      s->fill[b].on_wall++;
+    return;
+  }
   if (write) {
     s->ops->initial_state(s, b, *n, x, y, dx);
     s->p.id[*n] = *n;
@@ -495,7 +503,7 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     return RHOD_ERR_SCENE;
   }
   /* the bodies where they stand at t = 0 (the fill leaves their insides empty) */
-  st = rhod_bodies_init(&s->bodies, sc, &s->bnd, 0.0, err, errlen);
+  st = rhod_bodies_init(&s->bodies, sc, &s->bnd, 0.0, 0.5 * s->dx_min, err, errlen);
   if (st != RHOD_OK) {
     if (st == RHOD_ERR_MEMORY)
       snprintf(err, errlen, "out of memory setting up the bodies");

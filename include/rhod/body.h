@@ -42,16 +42,24 @@ typedef struct {
   int n;
   rhod_body_state *b;
   int moving;   /* some body is not fixed */
-  real *fghost; /* scratch: per ghost (fx, fy) of the force pass, 2 reals, device */
+  real *fghost; /* scratch: per ghost (fx, fy) of the viscous pass, 2 reals, device */
   size_t fghost_cap;
+  /* the pressure's quadrature points on the bodies' boundaries (spacing at most half the
+   * finest particle size): at zero displacement (x0, y0, outward normal n0, length ds,
+   * body), and where they stand now with the pressure there (device: px, py, fp, gam) */
+  int ns;
+  double *x0, *y0, *nx0, *ny0, *ds;
+  int *sb;
+  real *px, *py, *fp, *gam;
 } rhod_bodies;
 
 /* Compiles the laws, sets the initial pose (imposed: the law at t; free: at rest at zero
  * displacement with the given velocities) and appends every body's boundary to b (after
- * the walls, rhod_boundary_init) at that pose. Errors: RHOD_ERR_SCENE with a one-line
+ * the walls, rhod_boundary_init) at that pose; ds: the largest spacing of the pressure's
+ * quadrature points along the boundaries. Errors: RHOD_ERR_SCENE with a one-line
  * message (a law libmatheval refuses), RHOD_ERR_MEMORY. */
-int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, double t, char *err,
-                     size_t errlen);
+int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, double t, double ds,
+                     char *err, size_t errlen);
 void rhod_bodies_free(rhod_bodies *bb);
 
 /* Moves every body's boundary in b to its state (q, qd, qdd) and copies it to the device. */
@@ -70,12 +78,15 @@ void rhod_bodies_stage(rhod_bodies *bb, const rhod_rk_table *tab, int s, double 
                        const double gravity[2]);
 
 /* The fluid's force and moment on every body (into bb->b[k].F) from the prepared state:
- * ghosts built (p->gbody set), cells over fluid and ghosts, P and V over both. The pair
- * form of Bouscasse et al. 2013 (paper 002 Ref. 8), central pair forces:
- *   F_B = sum_{j ghost of B} sum_{i fluid} [(P_i + P_j) - 2 (d + 2) mu pi_ij] grad_i W_ij V_i V_j,
- *   M_B = sum (x_j - x_G) x [the same term],  pi_ij = (u_i - u_j).(x_i - x_j) / |x_i - x_j|^2,
- * W with fluid particle i's radius (ratio dx_i). mu: the dynamic viscosity (0: inviscid).
- * RHOD_ERR_MEMORY when the scratch cannot grow. */
+ * ghosts built (p->gbody set), cells over fluid and ghosts, P and V over both.
+ * Pressure: the surface integral F = -oint P n dS, M = -oint (x - x_G) x P n dS over the
+ * quadrature points, P there the Shepard interpolation over fluid and ghosts (paper 000
+ * Eq. 8; 0 where Gamma < 0.1, a dry point of a body piercing the surface).
+ * Viscosity (mu > 0): the viscous part of the pair form of Bouscasse et al. 2013 (paper
+ * 002 Ref. 8), central pair forces, F = sum_{j ghost of B} sum_{i fluid} -2 (d + 2) mu pi_ij
+ * grad_i W_ij V_i V_j, M = sum (x_j - x_G) x [the same], pi_ij = (u_i - u_j).(x_i - x_j) /
+ * |x_i - x_j|^2, W with fluid particle i's radius (ratio dx_i). Our choices: docs/choices.md
+ * "bodies: force". RHOD_ERR_MEMORY when the scratch cannot grow. */
 int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
                        real ratio, const real *P, const real *V, real mu);
 

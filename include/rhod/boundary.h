@@ -112,6 +112,10 @@ static inline rhod_point rhod_walls_keep_off(const real *seg, int nseg, const re
   return q;
 }
 
+/* Distance from a point to the nearest body's boundary (either side); +HUGE_VAL without
+ * bodies. Host side, for setup. */
+double rhod_body_distance(const rhod_boundary *b, double x, double y);
+
 /* Signed distance from a point to the nearest wall (positive on the fluid side);
  * +HUGE_VAL when there are no walls. Host side, for setup. */
 double rhod_wall_distance(const rhod_boundary *b, double x, double y);
