@@ -104,6 +104,38 @@ check "multiphase: resumed run identical to the uninterrupted one" -- same_outpu
 check "multiphase: the snapshots hold the phase" -- \
   grep -q "snapshot_0010.h5:/PartType0/Phase" "$T/n/snapshots.xdmf"
 
+# 6. bodies (issue 51): a free cylinder falling (x and theta locked) and a box moved by a
+#    law, in a tank; their motion (q, its rate, the acceleration the ghost pressure uses)
+#    comes back from the checkpoint's named scalars
+cat >"$T/bodies.yaml" <<'YAML'
+name: bodies_restart
+time: {end: 0.2, output_every: 0.02}
+particles: {dx: 0.01}
+physics: {rho0: 1000, c0: 20, gravity: [0, -9.81]}
+fluid:
+  - rect: {min: [0, 0], max: [0.4, 0.3]}
+walls:
+  - rect: {min: [0, 0], max: [0.4, 0.5]}
+bodies:
+  - name: ball
+    circle: {center: [0.12, 0.18], radius: 0.04}
+    motion: free
+    density: 1500
+    lock: [x, theta]
+  - name: paddle
+    rect: {min: [0.26, 0.12], max: [0.32, 0.18]}
+    slip: no
+    motion: imposed
+    law: {y: "0.005*sin(20*t)", theta: "0.1*t^2"}
+probes: {every: 0.005, list: [{kinetic_energy: {}}]}
+YAML
+expect 0 "bodies: uninterrupted run" -- "$RHOD" run "$T/bodies.yaml" -o "$T/p" --checkpoint-every 0.1
+check "bodies: the ball fell" -- awk -F, 'NR > 1 { y = $7 } END { exit !(y < 0.17) }' "$T/p/probes.csv"
+cp -r "$T/p" "$T/q"
+rm -f "$T/q"/snapshot_0008.* "$T/q"/snapshot_0009.* "$T/q"/snapshot_0010.*
+expect 0 "bodies: resume after a crash" -- "$RHOD" resume "$T/q"
+check "bodies: resumed run identical to the uninterrupted one" -- same_outputs "$T/p" "$T/q"
+
 # 4. bad checkpoints: exit 10, one line naming the file and the reason
 cp -r "$T/a" "$T/d"
 printf 'X' | dd of="$T/d/checkpoint.rhod" bs=1 seek=5000 conv=notrunc 2>/dev/null
