@@ -327,6 +327,103 @@ static void test_free_motion(void) {
   free(sc);
 }
 
+/* No silent cap (bodies.md's defects 3): a container whose bottom is 36 collinear segments
+ * gives the particle in its far corner, between segments 35 and 36, its double mirror (the
+ * corner list once looked at the first 32 segments only), and a particle may have more
+ * than 6 ghosts. */
+static void test_no_cap(void) {
+  rhod_scene *sc = unit_scene(DX);
+  rhod_wall w;
+  memset(&w, 0, sizeof w);
+  double pts[40][2];
+  unsigned np = 0;
+  for (int k = 0; k <= 36; k++) /* the bottom, 36 segments from x = 0 to 0.36 */
+    pts[np][0] = 0.01 * k, pts[np][1] = 0, np++;
+  pts[np][0] = 0.36, pts[np][1] = 0.2, np++;
+  pts[np][0] = 0, pts[np][1] = 0.2, np++;
+  w.shape.kind = RHOD_SHAPE_POLYGON;
+  w.shape.points = pts, w.shape.n_points = np;
+  w.fluid_inside = 1;
+  sc->walls = &w, sc->n_walls = 1;
+  rhod_boundary b;
+  rhod_particles p;
+  const double lo[2] = {0, 0}, hi[2] = {0.36, 0.2};
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, 64), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&b, sc, lo, hi), RHOD_OK);
+  CU_ASSERT(b.nseg == 39 && b.ncorner == 4);
+  /* the far corner's particle: mirrored in segment 35 and in the right wall, and twice */
+  p.x[0] = 0.355, p.y[0] = 0.005;
+  /* a particle over the bottom's joints: a mirror in each segment its foot lies on */
+  p.x[1] = 0.1, p.y[1] = 0.005;
+  for (int i = 0; i < 2; i++)
+    p.m[i] = (real)(RHO * DX * DX), p.dx[i] = (real)DX, p.rho[i] = (real)RHO;
+  p.n = 2;
+  rhod_particles_to_device(&p);
+  CU_ASSERT_EQUAL_FATAL(rhod_ghosts_build(&b, &p, (real)RATIO, (real)(RATIO * DX)), RHOD_OK);
+  const size_t nt = p.n + p.ng;
+  rhod_to_host(p.x, nt * sizeof(real));
+  rhod_to_host(p.y, nt * sizeof(real));
+  rhod_to_host(p.gsrc, nt * sizeof(int32_t));
+  int n0 = 0, n1 = 0, dbl = 0;
+  for (size_t g = p.n; g < nt; g++) {
+    if (p.gsrc[g] == 0) {
+      n0++;
+      dbl |= fabs(p.x[g] - 0.365) < 1e-12 && fabs(p.y[g] + 0.005) < 1e-12;
+    } else
+      n1++;
+  }
+  printf("\n  ghosts: %d of the corner particle (double mirror %s), %d over the joints\n", n0,
+         dbl ? "there" : "missing", n1);
+  CU_ASSERT(dbl);
+  CU_ASSERT(n0 >= 3);
+  /* at x = 0.1 the foot lies on segments 9 and 10 (their shared end): two mirrors at one
+   * place is what the flat wall made of pieces gives; what matters is none is dropped */
+  CU_ASSERT(n1 >= 1);
+  rhod_boundary_free(&b);
+  rhod_particles_free(&p);
+  free(sc);
+}
+
+/* The wall guard against a moving body (bodies.md's defect 5): a box moving at -1 m/s
+ * along x overtakes a particle at rest, which ends a step 0.1 dx inside its left face:
+ * it is put back in front of the face and leaves with twice the box's speed (the normal
+ * velocity relative to the face reflected), where a guard for walls at rest would have
+ * left it at rest, to be overtaken again. */
+static void test_guard_moving(void) {
+  rhod_scene *sc = unit_scene(DX);
+  rhod_body B;
+  memset(&B, 0, sizeof B);
+  B.name = "box";
+  B.shape.kind = RHOD_SHAPE_RECT;
+  B.shape.min[0] = 0.3, B.shape.min[1] = 0.3, B.shape.max[0] = 0.5, B.shape.max[1] = 0.5;
+  B.center[0] = B.center[1] = 0.4;
+  B.motion = RHOD_MOTION_FREE;
+  B.mass = 1, B.inertia = 1;
+  B.velocity[0] = -1;
+  sc->bodies = &B, sc->n_bodies = 1;
+  rhod_boundary b;
+  rhod_bodies bb;
+  rhod_particles p;
+  char err[64];
+  const double lo[2] = {0, 0}, hi[2] = {1, 1};
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, 64), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&b, sc, lo, hi), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_bodies_init(&bb, sc, &b, 0, 0.5 * DX, err, sizeof err), RHOD_OK);
+  p.x[0] = 0.3 + 0.1 * DX, p.y[0] = 0.4, p.ux[0] = 0, p.uy[0] = 0, p.dx[0] = (real)DX;
+  p.n = 1;
+  rhod_particles_to_device(&p);
+  CU_ASSERT_EQUAL(rhod_walls_guard(&b, &p), 1);
+  rhod_to_host(p.x, sizeof(real));
+  rhod_to_host(p.ux, sizeof(real));
+  printf("\n  guard: x = %.6f (face at 0.3), u = %.3f\n", (double)p.x[0], (double)p.ux[0]);
+  CU_ASSERT(fabs(p.x[0] - (0.3 - 0.1 * DX)) < EPS);
+  CU_ASSERT(fabs(p.ux[0] + 2) < EPS);
+  rhod_bodies_free(&bb);
+  rhod_boundary_free(&b);
+  rhod_particles_free(&p);
+  free(sc);
+}
+
 int main(void) {
   static const rhod_test_case cases[] = {
       {"convex corner tiled once", test_convex_corner},
@@ -334,6 +431,8 @@ int main(void) {
       {"moving body kinematics", test_moving_kinematics},
       {"buoyancy from the pressure integral", test_buoyancy},
       {"free motion in lockstep", test_free_motion},
+      {"no cap on segments and mirrors", test_no_cap},
+      {"wall guard against a moving body", test_guard_moving},
   };
   return RHOD_RUN_TESTS("bodies", cases);
 }
