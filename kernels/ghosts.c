@@ -530,19 +530,34 @@ long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *b
   long bad = n;
   RHOD_KERNEL_LOOP_REDUCE(min, bad)
   for (long i = 0; i < n; i++) {
-    const real lim = (real)0.5 * dx[i];
-    /* the nearest body segment decides the side (its normal points into the fluid) */
-    real best = -1, sd = 0;
+    const real lim = (real)0.5 * dx[i], xi = x[i], yi = y[i];
+    /* deeper than lim into the body of the nearest segment: inside its polygon by the
+     * crossings of a ray along +x (each segment from its start to the next one's, the
+     * polygon's own vertices). The sign of the nearest segment's normal distance, used
+     * until 2026-12-06, is undecided where a vertex is nearest to both of its faces:
+     * cases/body_refine stopped on a particle just below the level of its wedge's top
+     * (then at 0.35 m), 0.19 m beside it, that rounding had given to the top face */
+    real best = -1;
+    int nearest = -1;
     for (int s = s0; s < s1; s++) {
-      const real *S = seg + RHOD_SEG_STRIDE * s;
-      const real e2 = seg_dist2(S, x[i], y[i]);
+      const real e2 = seg_dist2(seg + RHOD_SEG_STRIDE * s, xi, yi);
       if (best < 0 || e2 < best)
-        best = e2, sd = S[2] * (x[i] - S[0]) + S[3] * (y[i] - S[1]);
+        best = e2, nearest = s;
     }
-    int in = best >= 0 && sd < 0 && best > lim * lim;
+    int in = 0;
+    if (nearest >= 0 && best > lim * lim) {
+      const real *N = seg + RHOD_SEG_STRIDE * nearest;
+      const int first = (int)N[11], count = (int)N[12];
+      for (int k = 0; k < count; k++) {
+        const real *A = seg + RHOD_SEG_STRIDE * (first + k);
+        const real *B = seg + RHOD_SEG_STRIDE * (first + (k + 1) % count);
+        if ((A[1] > yi) != (B[1] > yi) && xi < A[0] + (yi - A[1]) * (B[0] - A[0]) / (B[1] - A[1]))
+          in = !in;
+      }
+    }
     for (int c = c0; c < c1; c++) {
       const real *C = circ + RHOD_CIRC_STRIDE * c;
-      const real rx = x[i] - C[0], ry = y[i] - C[1];
+      const real rx = xi - C[0], ry = yi - C[1];
       in |= sqrt(rx * rx + ry * ry) < C[2] - lim;
     }
     if (in && i < bad)

@@ -226,12 +226,57 @@ static void test_circle(void) {
   }
 }
 
+/* rhod_bodies_entered (kernels/ghosts.c), which stops a run when a particle is more than
+ * half its size inside a body: points on the extension of a wedge's face beyond a vertex
+ * have that vertex as the nearest point of both faces meeting there, and the face's own
+ * normal distance is 0 up to rounding; they lie outside. Until 2026-12-06 the nearest
+ * face's sign decided, and cases/body_refine stopped at step 3 on a particle level with
+ * the top of its wedge (then at 0.35 m), 0.19 m beside it. A point deep inside is found, one less
+ * than half its size inside is not. */
+static void test_entered(void) {
+  setup t;
+  init(&t);
+  add_wedge(&t, 1);
+  double q[MAXP][2], s[MAXP];
+  /* the right face runs from the keel along (tx, ty); its outward normal is (ty, -tx). The
+   * points lie on its extension beyond either end, moved 1e-10 m towards the body's
+   * side of its line: outside the body, but the face's normal distance is negative */
+  const double tx = cos(RHOD_PI / 6), ty = 0.5, in = 1e-10;
+  int n = 0;
+  for (int k = 1; k <= 10; k++) {
+    q[n][0] = 0.6 + 0.0137 * k * tx - in * ty, q[n][1] = 0.257735 + 0.0137 * k * ty + in * tx;
+    s[n++] = DX;
+    q[n][0] = 0.5 - 0.0137 * k * tx - in * ty, q[n][1] = 0.2 - 0.0137 * k * ty + in * tx;
+    s[n++] = DX;
+  }
+  for (int k = 1; k <= 10; k++) /* just below the top face's level, beside the body */
+    q[n][0] = 0.4 - 0.019 * k, q[n][1] = 0.35 - in, s[n++] = DX;
+  flag(&t, (const double(*)[2])q, s, n);
+  int body = 7;
+  CU_ASSERT_EQUAL(rhod_bodies_entered(&t.b, &t.p, &body), -1);
+  CU_ASSERT_EQUAL(body, -1);
+  unmake(&t);
+  /* inside: 0.4 dx below the top face (not past half its size), then 0.6 dx */
+  for (int deep = 0; deep < 2; deep++) {
+    init(&t);
+    add_wedge(&t, 1);
+    const double p1[2][2] = {{0.2, 0.5}, {0.5, 0.35 - (deep ? 0.6 : 0.4) * DX}};
+    const double s1[2] = {DX, DX};
+    flag(&t, p1, s1, 2);
+    body = 7;
+    CU_ASSERT_EQUAL(rhod_bodies_entered(&t.b, &t.p, &body), deep ? 1 : -1);
+    CU_ASSERT_EQUAL(body, deep ? 0 : -1);
+    unmake(&t);
+  }
+}
+
 int main(void) {
   static const rhod_test_case cases[] = {
       {"a body's convex vertices reach the support", test_convex_vertex},
       {"each particle with its own radius", test_own_radius},
       {"refine: false per body and per wall", test_switches},
       {"circle body and circle wall", test_circle},
+      {"a particle inside a body, none beside a vertex", test_entered},
   };
   return RHOD_RUN_TESTS("criterion 4", cases);
 }
