@@ -226,41 +226,50 @@ static int ensure_count(rhod_boundary *b, size_t need) {
   return b->count ? RHOD_OK : RHOD_ERR_MEMORY;
 }
 
-/* Whether a support of radius R at (x, y) reaches a body with its refine flag set: by the
- * distance to its segments (vertices included) and circles (paper 002 criterion 4, per
- * body). */
-static inline int body_near(const real *seg, int nseg, const real *circ, int ncirc, real x, real y,
-                            real R) {
+/* Whether a support of radius R at (x, y) reaches a wall or body whose refine flag
+ * (S[13], C[6]) is set (paper 002 Sec. V B, criterion 4, switchable per body and per
+ * wall: "disabled at the bottom part of the tank" in its case F). A body by the distance
+ * to its segments (vertices included, so that convex corners are seen) or circle; a wall
+ * where (x, y) has a mirror in it (in front of a segment by less than R with its foot on
+ * it, or inside a circle's reach with a mirror radius > 0): the test rhod_walls_near has
+ * made for walls since criterion 4 came in, kept so that the refined layouts of the APR
+ * scenes stay as they were (a concave corner's double mirror needs both segments' mirrors,
+ * so it adds nothing). */
+static inline int support_reaches(const real *seg, int nseg, const real *circ, int ncirc, real x,
+                                  real y, real R) {
   for (int s = 0; s < nseg; s++) {
     const real *S = seg + RHOD_SEG_STRIDE * s;
-    if (S[10] >= 0 && S[13] != 0 && seg_dist2(S, x, y) < R * R)
+    if (S[13] == 0)
+      continue;
+    if (S[10] >= 0 ? seg_dist2(S, x, y) < R * R : seg_near(S, x, y, R))
       return 1;
   }
   for (int c = 0; c < ncirc; c++) {
     const real *C = circ + RHOD_CIRC_STRIDE * c;
-    const real rx = x - C[0], ry = y - C[1];
-    const real d = sqrt(rx * rx + ry * ry) - C[2];
-    if (C[5] >= 0 && C[6] != 0 && d < R && d > -R)
-      return 1;
+    if (C[6] == 0)
+      continue;
+    const real rx = x - C[0], ry = y - C[1], dist = sqrt(rx * rx + ry * ry);
+    if (C[5] >= 0) {
+      const real d = dist - C[2];
+      if (d < R && d > -R)
+        return 1;
+    } else if (dist > 0) {
+      const real d = C[3] > 0 ? C[2] - dist : dist - C[2]; /* distance into the fluid */
+      const real rg = C[3] > 0 ? C[2] + d : C[2] - d;      /* mirror radius */
+      if (d > 0 && d < R && rg > 0)
+        return 1;
+    }
   }
   return 0;
 }
 
 void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real ratio, uint8_t *near) {
-  /* walls: where i has a mirror; bodies: by distance */
-  const int nseg = b->nwallseg, ncorner = b->ncorner, ncirc = b->nwallcirc;
-  const int nbs = b->nseg, nbc = b->ncirc, bodies = b->nbody > 0;
+  const int nseg = b->nseg, ncirc = b->ncirc;
   const real *seg = b->seg, *circ = b->circ, *x = p->x, *y = p->y, *dx = p->dx;
-  const int32_t *corner = b->corner;
   const long n = (long)p->n;
   RHOD_KERNEL_LOOP
-  for (long i = 0; i < n; i++) {
-    const real R = ratio * dx[i];
-    near[i] = (nseg + ncirc > 0 &&
-               wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, NULL, x[i], y[i], R, 0, NULL,
-                            NULL, NULL, NULL, NULL, NULL, NULL, NULL) > 0) ||
-              (bodies && body_near(seg, nbs, circ, nbc, x[i], y[i], R));
-  }
+  for (long i = 0; i < n; i++)
+    near[i] = (uint8_t)support_reaches(seg, nseg, circ, ncirc, x[i], y[i], ratio * dx[i]);
 }
 
 /* Phase 1: wall mirrors of the fluid. Returns the number of ghosts written or < 0. */
@@ -521,19 +530,34 @@ long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *b
   long bad = n;
   RHOD_KERNEL_LOOP_REDUCE(min, bad)
   for (long i = 0; i < n; i++) {
-    const real lim = (real)0.5 * dx[i];
-    /* the nearest body segment decides the side (its normal points into the fluid) */
-    real best = -1, sd = 0;
+    const real lim = (real)0.5 * dx[i], xi = x[i], yi = y[i];
+    /* deeper than lim into the body of the nearest segment: inside its polygon by the
+     * crossings of a ray along +x (each segment from its start to the next one's, the
+     * polygon's own vertices). The sign of the nearest segment's normal distance, used
+     * until 2026-12-06, is undecided where a vertex is nearest to both of its faces:
+     * cases/body_refine stopped on a particle just below the level of its wedge's top
+     * (then at 0.35 m), 0.19 m beside it, that rounding had given to the top face */
+    real best = -1;
+    int nearest = -1;
     for (int s = s0; s < s1; s++) {
-      const real *S = seg + RHOD_SEG_STRIDE * s;
-      const real e2 = seg_dist2(S, x[i], y[i]);
+      const real e2 = seg_dist2(seg + RHOD_SEG_STRIDE * s, xi, yi);
       if (best < 0 || e2 < best)
-        best = e2, sd = S[2] * (x[i] - S[0]) + S[3] * (y[i] - S[1]);
+        best = e2, nearest = s;
     }
-    int in = best >= 0 && sd < 0 && best > lim * lim;
+    int in = 0;
+    if (nearest >= 0 && best > lim * lim) {
+      const real *N = seg + RHOD_SEG_STRIDE * nearest;
+      const int first = (int)N[11], count = (int)N[12];
+      for (int k = 0; k < count; k++) {
+        const real *A = seg + RHOD_SEG_STRIDE * (first + k);
+        const real *B = seg + RHOD_SEG_STRIDE * (first + (k + 1) % count);
+        if ((A[1] > yi) != (B[1] > yi) && xi < A[0] + (yi - A[1]) * (B[0] - A[0]) / (B[1] - A[1]))
+          in = !in;
+      }
+    }
     for (int c = c0; c < c1; c++) {
       const real *C = circ + RHOD_CIRC_STRIDE * c;
-      const real rx = x[i] - C[0], ry = y[i] - C[1];
+      const real rx = xi - C[0], ry = yi - C[1];
       in |= sqrt(rx * rx + ry * ry) < C[2] - lim;
     }
     if (in && i < bad)

@@ -105,7 +105,7 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
   for (unsigned w = 0; w < sc->n_walls; w++) {
     const rhod_wall *W = &sc->walls[w];
     const int st = push_shape(b, &W->shape, W->fluid_inside, W->slip == RHOD_SLIP_NO, W->velocity,
-                              W->moving_edges, -1, 1);
+                              W->moving_edges, -1, W->refine);
     if (st != RHOD_OK)
       return st;
   }

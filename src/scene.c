@@ -83,6 +83,7 @@ typedef struct {
   double *velocity;
   double *edges;
   unsigned n_edges;
+  bool *refine;
 } y_wall;
 
 /* rs: the rhodsph scheme's keys in the shared sections (src/rhodsph/scene_rs.h) */
@@ -348,6 +349,7 @@ static const cyaml_schema_field_t f_wall[] = {
     VEC("velocity", OPT, y_wall, velocity),
     CYAML_FIELD_SEQUENCE_COUNT("edges", OPT | CYAML_FLAG_FLOW, y_wall, edges, n_edges,
                                &rhod_sl_sch_float, 1, CYAML_UNLIMITED),
+    BOOL_OPT("refine", y_wall, refine),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_wall = {
@@ -1797,6 +1799,7 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     TRY(rhod_sl_load_shape(c, path, y->rect, y->circle, y->polygon, y->n_polygon, &w->shape));
     w->slip = y->slip ? (rhod_slip)*y->slip : RHOD_SLIP_FREE;
     w->fluid_inside = opt_bool(y->fluid_inside, 1);
+    w->refine = opt_bool(y->refine, 1);
     TRY(load_wall_motion(c, y, i, w, s->periodic));
   }
   /* bodies (src/scene_bodies.c): after the domain and the walls, which they are checked
@@ -2167,6 +2170,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
         if ((w->moving_edges >> k) & 1u)
           tb_num(&t, edges, NULL, k);
     }
+    if (!w->refine) /* absent at its default, so older checkpoints resume */
+      tb_bool(&t, e, "refine", 0);
   }
   rhod_bd_tree(&t, root, s);
   m = tb_coll(&t, root, "probes", RY_MAP, 0);

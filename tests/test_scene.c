@@ -79,6 +79,8 @@ static void test_full_scene(void) {
   CU_ASSERT_EQUAL(s->walls[1].shape.kind, RHOD_SHAPE_CIRCLE);
   CU_ASSERT_EQUAL(s->walls[1].slip, RHOD_SLIP_FREE);
   CU_ASSERT_FALSE(s->walls[1].fluid_inside);
+  CU_ASSERT_TRUE(s->walls[0].refine); /* the default */
+  CU_ASSERT_FALSE(s->walls[1].refine);
 
   CLOSE(s->probe_every, 0.001);
   CU_ASSERT_EQUAL_FATAL(s->n_probes, 8);
@@ -501,6 +503,7 @@ static void test_params(void) {
       {"fluid.2.polygon", "[[1, 0], [0.5, 1], [0, 0]]"},
       {"walls.0.slip", "no"},
       {"walls.1.fluid_inside", "false"},
+      {"walls.1.refine", "false"},
       {"probes.every", "0.001"},
       {"probes.list.0.pressure.name", "P1"},
       {"probes.list.3.front.direction", "[0.6, 0.8]"},
@@ -513,6 +516,8 @@ static void test_params(void) {
       fprintf(stderr, "\n%s: '%s', expected '%s'\n", want[i].key, v ? v : "(none)", want[i].value);
     CU_ASSERT_TRUE(v && strcmp(v, want[i].value) == 0);
   }
+  /* walls.N.refine at its default (true) is not written, so older checkpoints resume */
+  CU_ASSERT_PTR_NULL(param(&p, "walls.0.refine"));
   for (unsigned i = 0; i < p.n; i++) /* leaves only */
     for (unsigned j = 0; j < p.n; j++)
       if (i != j) {

@@ -67,9 +67,10 @@ void rhod_boundary_free(rhod_boundary *b);
 int rhod_ghosts_build(rhod_boundary *b, rhod_particles *p, real radius_ratio, real margin);
 
 /* near[i] = 1 when the support of fluid particle i (radius radius_ratio * dx_i)
- * reaches a wall or a body whose refine flag is set, else 0 (refinement criterion 4 of
- * paper 002 Sec. V B): for a wall, where i has a mirror in it; for a body, by the
- * distance to its segments (vertices included) or circle. */
+ * reaches a wall or a body whose refine flag is set (walls.N.refine, bodies.N.refine:
+ * S[13], C[6]), else 0 (refinement criterion 4 of paper 002 Sec. V B): for a wall, where
+ * i has a mirror in it; for a body, by the distance to its segments (vertices included)
+ * or circle. */
 void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real radius_ratio,
                      uint8_t *near);
 

@@ -80,6 +80,8 @@ typedef struct {
   unsigned moving_edges; /* bit k: edge k moves (rect: 0 bottom, 1 right, 2 top, 3 left;
                             polygon: from points[k] to points[k+1], in the stored
                             counter-clockwise order); 0 when the velocity is zero */
+  int refine;            /* walls.N.refine: refinement criterion 4 near this wall (paper 002
+                            Sec. V B; case F switches it off at the bottom), default 1 */
 } rhod_wall;
 
 /* bodies.N.motion: how a body moves (include/rhod/body.h). */
