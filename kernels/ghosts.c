@@ -24,23 +24,28 @@ static inline real seg_dist2(const real *S, real x, real y) {
   return ex * ex + ey * ey;
 }
 
-/* A body's boundary velocity and acceleration at (fx, fy) from its kinematics K
- * (RHOD_KIN_STRIDE): u_w = U + Omega x r, a_w = A + dOmega/dt x r - Omega^2 r, r = f - G. */
-static inline void body_kin(const real *K, real fx, real fy, real *uw, real *aw) {
-  const real rx = fx - K[0], ry = fy - K[1], W = K[4], Wd = K[7];
-  uw[0] = K[2] - W * ry, uw[1] = K[3] + W * rx;
-  aw[0] = K[5] - Wd * ry - W * W * rx, aw[1] = K[6] + Wd * rx - W * W * ry;
+/* A body's boundary velocity at (fx, fy) from its kinematics K (RHOD_KIN_STRIDE):
+ * u_w = U + Omega x r, r = f - G (scalars, not a local array: offload_frames). */
+static inline real body_uwx(const real *K, real fx, real fy) {
+  (void)fx;
+  return K[2] - K[4] * (fy - K[1]);
+}
+static inline real body_uwy(const real *K, real fx, real fy) {
+  (void)fy;
+  return K[3] + K[4] * (fx - K[0]);
 }
 
 /* A body ghost's wall parts (docs/choices.md "bodies"): u_g = u_w + T (u_s - u_w), so
- * U = (I - T) u_w; A = a_w. */
+ * U = (I - T) u_w; A = a_w = A_G + dOmega/dt x r - Omega^2 r, r = f - G. */
 static inline void body_ghost(const real *K, real fx, real fy, const real *Tn, real *Un, real *An) {
-  real uw[2], aw[2];
-  body_kin(K, fx, fy, uw, aw);
-  Un[0] = uw[0] - (Tn[0] * uw[0] + Tn[1] * uw[1]);
-  Un[1] = uw[1] - (Tn[2] * uw[0] + Tn[3] * uw[1]);
-  if (An)
-    An[0] = aw[0], An[1] = aw[1];
+  const real uwx = body_uwx(K, fx, fy), uwy = body_uwy(K, fx, fy);
+  Un[0] = uwx - (Tn[0] * uwx + Tn[1] * uwy);
+  Un[1] = uwy - (Tn[2] * uwx + Tn[3] * uwy);
+  if (An) {
+    const real rx = fx - K[0], ry = fy - K[1], W = K[4], Wd = K[7];
+    An[0] = K[5] - Wd * ry - W * W * rx;
+    An[1] = K[6] + Wd * rx - W * W * ry;
+  }
 }
 
 /* Mirrors of (x, y) in the walls and bodies within R: positions, Jacobians J, velocity
@@ -466,9 +471,9 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
         /* a body's boundary moves: the normal velocity relative to it is reflected */
         real wx = 0, wy = 0;
         if (S[10] >= 0) {
-          real uw[2], aw[2];
-          body_kin(kin + RHOD_KIN_STRIDE * (int)S[10], x[i] - d * S[2], y[i] - d * S[3], uw, aw);
-          wx = uw[0], wy = uw[1];
+          const real *K = kin + RHOD_KIN_STRIDE * (int)S[10];
+          wx = body_uwx(K, x[i] - d * S[2], y[i] - d * S[3]);
+          wy = body_uwy(K, x[i] - d * S[2], y[i] - d * S[3]);
         }
         x[i] -= 2 * d * S[2], y[i] -= 2 * d * S[3];
         const real un = (ux[i] - wx) * S[2] + (uy[i] - wy) * S[3];
@@ -504,10 +509,9 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
         const real ex = C[3] * (-rx / dist), ey = C[3] * (-ry / dist); /* into the fluid */
         real wx = 0, wy = 0;
         if (C[5] >= 0) {
-          real uw[2], aw[2];
-          body_kin(kin + RHOD_KIN_STRIDE * (int)C[5], C[0] + C[2] * rx / dist,
-                   C[1] + C[2] * ry / dist, uw, aw);
-          wx = uw[0], wy = uw[1];
+          const real *K = kin + RHOD_KIN_STRIDE * (int)C[5];
+          wx = body_uwx(K, C[0] + C[2] * rx / dist, C[1] + C[2] * ry / dist);
+          wy = body_uwy(K, C[0] + C[2] * rx / dist, C[1] + C[2] * ry / dist);
         }
         x[i] -= 2 * d * ex, y[i] -= 2 * d * ey;
         const real un = (ux[i] - wx) * ex + (uy[i] - wy) * ey;
