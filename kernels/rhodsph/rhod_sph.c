@@ -402,14 +402,18 @@ static inline real ghost_div(const real *J, const real *T, const real *U, real D
 void rhod_sph_mirror_gradients(rhod_sph *s, rhod_particles *p) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   const int32_t *gsrc = p->gsrc;
-  const real *gJ = p->gJ, *gT = p->gT, *rho = p->rho;
+  const real *gJ = p->gJ, *gT = p->gT, *rho = p->rho, *gA = p->gA;
   real *gP = s->gP, *gu = s->gu, *D = s->D;
-  const real gx = s->gx, gy = s->gy;
+  const real gx0 = s->gx, gy0 = s->gy;
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++) {
     const int k = gsrc[g];
     const real *J = gJ + 4 * g, *T = gT + 4 * g;
     const real px = gP[2 * k], py = gP[2 * k + 1];
+    /* a moving body's ghost: g - a_w, as its pressure (rhod_sph_fill_state) */
+    real gx = gx0, gy = gy0;
+    if (gA)
+      gx -= gA[2 * g], gy -= gA[2 * g + 1];
     const real Jgx = J[0] * gx + J[1] * gy, Jgy = J[2] * gx + J[3] * gy;
     const real ea = rho[g] / rho[k];
     gP[2 * g] = ea * (J[0] * px + J[1] * py) + rho[g] * (gx - Jgx);
