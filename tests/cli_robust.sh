@@ -119,8 +119,10 @@ check "the repeated run's last snapshot is the same" -- \
   cmp "$T/again/snapshot_0002.png" "$T/repeat/snapshot_0002.png"
 # bodies (issue 51): --set on a body, the scene as run reads back to the same scene
 BODIES=$SRC/tests/scenes/good/bodies.yaml
+# (box at the fluid's density: the scene's 2 kg/m, a tenth of it, is past what the explicit
+# coupling bears, docs/choices.md "bodies: motion")
 BSHORT=(--set time.end=0.002 --set time.output_every=0.001 --set bodies.0.slip=no
-        --set "bodies.2.law.x=0.01*sin(t)")
+        --set "bodies.2.law.x=0.01*sin(t)" --set bodies.0.mass=20)
 expect 0 "bodies: a run" -- "$RHOD" run "$BODIES" -o "$T/bodies" "${BSHORT[@]}"
 check "bodies: --set applied" -- grep -q 'x: 0.01\*sin(t)' "$T/bodies/scene.yaml"
 expect 0 "bodies: rhod run OUT/scene.yaml" -- "$RHOD" run "$T/bodies/scene.yaml" -o "$T/bodies2"
