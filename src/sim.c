@@ -223,7 +223,8 @@ static void emit(rhod_sim *s, unsigned b, double x, double y, double dx, size_t 
    * with its own mirror (docs/choices.md "bodies: fill"; one exactly dx/2 off, as a lattice
    * beside a face half-way between rows, stays); the walls' lattices stand dx/2
    * off them by construction */
-  if (s->bnd.nbody > 0 && rhod_body_distance(&s->bnd, x, y) < 0.5 * dx * (1 - 1e-6)) {
+  if (s->bnd.nbody > 0 &&
+      rhod_body_distance(&s->bnd, x, y) < 0.5 * dx * (1 - 2 * (double)RHOD_SUPPORT_TIE)) {
     if (!write)
       s->fill[b].on_wall++;
     return;
