@@ -22,11 +22,7 @@ static int viscous(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c
   }
   /* the scan radius: a fluid particle's own R_i (it gathers with it), the largest */
   const real *dx = p->dx;
-  real dmax = 0;
-  RHOD_KERNEL_LOOP_REDUCE(max, dmax)
-  for (long i = 0; i < n; i++)
-    dmax = dx[i] > dmax ? dx[i] : dmax;
-  const real Rmax = ratio * dmax;
+  const real Rmax = ratio * rhod_max_real(dx, n);
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx, *gbody = p->gbody;
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy;

@@ -10,11 +10,7 @@ void rhod_shepard(const rhod_cells *c, int kern, real ratio, const real *x, cons
   /* the largest radius: a point has no size of its own, so its scan must reach every
    * particle whose support holds it, R_j <= ratio max dx (the cells' reach covers it,
    * rhod_cell_reach) */
-  real dmax = 0;
-  RHOD_KERNEL_LOOP_REDUCE(max, dmax)
-  for (long j = 0; j < nb; j++)
-    dmax = dx[j] > dmax ? dx[j] : dmax;
-  const real Rmax = ratio * dmax;
+  const real Rmax = ratio * rhod_max_real(dx, nb);
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx;
   const int any = nb > 0;

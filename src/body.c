@@ -1,6 +1,7 @@
 /* Rigid bodies, host side: laws of motion (libmatheval), poses, the lockstep integration
  * of free bodies, probe columns, outlines and checkpoint extras (body.h). */
 #include "rhod/body.h"
+#include "rhod/io.h"
 #include "rhod/kernel.h"
 #include <math.h>
 #include <matheval.h>
@@ -46,8 +47,8 @@ void rhod_bodies_impose(rhod_bodies *bb, double t) {
 }
 
 /* The quadrature points of the boundary of shape sh (at zero displacement), at most ds
- * apart, into bb from index *q (count only when bb->x0 is NULL). */
-static void shape_samples(rhod_bodies *bb, int body, const rhod_shape *sh, double ds, int *q) {
+ * apart, into bb from index *q (count only when bb->x0 is NULL). RHOD_ERR_MEMORY or RHOD_OK. */
+static int shape_samples(rhod_bodies *bb, int body, const rhod_shape *sh, double ds, int *q) {
   if (sh->kind == RHOD_SHAPE_CIRCLE) {
     const int m = (int)fmax(16, ceil(2 * RHOD_PI * sh->radius / ds));
     for (int k = 0; k < m; k++, (*q)++)
@@ -59,14 +60,12 @@ static void shape_samples(rhod_bodies *bb, int body, const rhod_shape *sh, doubl
         bb->ds[*q] = 2 * RHOD_PI * sh->radius / m;
         bb->sb[*q] = body;
       }
-    return;
+    return RHOD_OK;
   }
-  const double rect[4][2] = {{sh->min[0], sh->min[1]},
-                             {sh->max[0], sh->min[1]},
-                             {sh->max[0], sh->max[1]},
-                             {sh->min[0], sh->max[1]}};
-  const unsigned np = sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points;
-  const double(*pt)[2] = sh->kind == RHOD_SHAPE_RECT ? rect : (const double(*)[2])sh->points;
+  double(*pt)[2] = malloc(sizeof(double[2]) * (sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points));
+  if (!pt)
+    return RHOD_ERR_MEMORY;
+  const unsigned np = rhod_shape_outline(sh, 0, pt);
   for (unsigned e = 0; e < np; e++) {
     const double *a = pt[e], *c = pt[(e + 1) % np];
     const double tx = c[0] - a[0], ty = c[1] - a[1], len = hypot(tx, ty);
@@ -82,6 +81,8 @@ static void shape_samples(rhod_bodies *bb, int body, const rhod_shape *sh, doubl
         bb->sb[*q] = body;
       }
   }
+  free(pt);
+  return RHOD_OK;
 }
 
 int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, double t, double ds,
@@ -126,7 +127,8 @@ int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, do
   /* the pressure's quadrature points */
   int q = 0;
   for (int k = 0; k < bb->n; k++)
-    shape_samples(bb, k, &sc->bodies[k].shape, ds, &q);
+    if (shape_samples(bb, k, &sc->bodies[k].shape, ds, &q) != RHOD_OK)
+      return RHOD_ERR_MEMORY;
   bb->ns = q;
   const size_t nq = (size_t)q;
   bb->x0 = malloc(sizeof(double) * nq), bb->y0 = malloc(sizeof(double) * nq);
@@ -139,7 +141,8 @@ int rhod_bodies_init(rhod_bodies *bb, const rhod_scene *sc, rhod_boundary *b, do
     return RHOD_ERR_MEMORY;
   q = 0;
   for (int k = 0; k < bb->n; k++)
-    shape_samples(bb, k, &sc->bodies[k].shape, ds, &q);
+    if (shape_samples(bb, k, &sc->bodies[k].shape, ds, &q) != RHOD_OK)
+      return RHOD_ERR_MEMORY;
   rhod_dev_map(bb->px, sizeof(real) * nq);
   rhod_dev_map(bb->py, sizeof(real) * nq);
   rhod_dev_map(bb->fp, sizeof(real) * nq);
@@ -267,6 +270,12 @@ void rhod_bodies_values(const rhod_bodies *bb, double *out) {
   }
 }
 
+/* The circle segments of an outline: at most seg_len long, at least 16. */
+static unsigned circle_segments(const rhod_shape *sh, double seg_len) {
+  const double m = ceil(2 * RHOD_PI * sh->radius / seg_len);
+  return m < 16 ? 16 : (m > 1e6 ? 1000000 : (unsigned)m);
+}
+
 int rhod_bodies_outline(const rhod_bodies *bb, double seg_len, unsigned **start, double **xy) {
   *start = calloc((size_t)bb->n + 1, sizeof **start);
   if (!*start)
@@ -274,13 +283,8 @@ int rhod_bodies_outline(const rhod_bodies *bb, double seg_len, unsigned **start,
   unsigned total = 0;
   for (int k = 0; k < bb->n; k++) {
     const rhod_shape *sh = &bb->b[k].desc->shape;
-    unsigned np = sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points;
-    if (sh->kind == RHOD_SHAPE_CIRCLE) {
-      const double m = ceil(2 * RHOD_PI * sh->radius / seg_len);
-      np = m < 16 ? 16 : (m > 1e6 ? 1000000 : (unsigned)m);
-    }
     (*start)[k] = total;
-    total += np;
+    total += rhod_shape_outline(sh, circle_segments(sh, seg_len), NULL);
   }
   (*start)[bb->n] = total;
   *xy = malloc(sizeof **xy * 2 * (total ? total : 1));
@@ -289,24 +293,16 @@ int rhod_bodies_outline(const rhod_bodies *bb, double seg_len, unsigned **start,
     *start = NULL;
     return RHOD_ERR_MEMORY;
   }
+  double(*pt)[2] = (double(*)[2]) * xy;
   for (int k = 0; k < bb->n; k++) {
     const rhod_body_state *B = &bb->b[k];
     const rhod_shape *sh = &B->desc->shape;
+    const unsigned a = (*start)[k];
+    /* the outline at zero displacement, then each point where the body stands */
+    const unsigned np = rhod_shape_outline(sh, circle_segments(sh, seg_len), pt + a);
     const double c = cos(B->q[2]), s = sin(B->q[2]);
-    const unsigned a = (*start)[k], np = (*start)[k + 1] - a;
-    for (unsigned j = 0; j < np; j++) {
-      double x0, y0;
-      if (sh->kind == RHOD_SHAPE_RECT) {
-        x0 = (j == 0 || j == 3) ? sh->min[0] : sh->max[0];
-        y0 = j < 2 ? sh->min[1] : sh->max[1];
-      } else if (sh->kind == RHOD_SHAPE_POLYGON) {
-        x0 = sh->points[j][0], y0 = sh->points[j][1];
-      } else {
-        const double phi = 2 * RHOD_PI * j / np;
-        x0 = sh->center[0] + sh->radius * cos(phi), y0 = sh->center[1] + sh->radius * sin(phi);
-      }
-      to_world(B, c, s, x0, y0, &(*xy)[2 * (a + j)], &(*xy)[2 * (a + j) + 1]);
-    }
+    for (unsigned j = a; j < a + np; j++)
+      to_world(B, c, s, pt[j][0], pt[j][1], &pt[j][0], &pt[j][1]);
   }
   return RHOD_OK;
 }

@@ -92,6 +92,14 @@ int rhod_particles_add_tags(rhod_particles *p) {
   return st;
 }
 
+real rhod_max_real(const real *v, long n) {
+  real m = 0;
+  RHOD_KERNEL_LOOP_REDUCE(max, m)
+  for (long i = 0; i < n; i++)
+    m = v[i] > m ? v[i] : m;
+  return m;
+}
+
 int rhod_particles_add_body_fields(rhod_particles *p) {
   int st = RHOD_OK;
   if (!p->gA)

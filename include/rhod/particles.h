@@ -65,6 +65,9 @@ int rhod_particles_add_field(rhod_particles *p, const char *name, void **ptr, si
                              int persistent);
 /* Registers the tags phase, kind and level (zero-filled, persistent). */
 int rhod_particles_add_tags(rhod_particles *p);
+/* The largest of v[0, n) (0 when n is 0): a reduction on the device, e.g. the largest
+ * particle size, whose radius a gather over mixed sizes scans. */
+real rhod_max_real(const real *v, long n);
 /* Registers gA and gbody (scratch; rhod_ghosts_build fills them): a scene with bodies. */
 int rhod_particles_add_body_fields(rhod_particles *p);
 /* Grows every array to at least `cap` (keeps content of persistent ones). */

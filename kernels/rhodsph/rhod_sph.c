@@ -517,10 +517,7 @@ int rhod_sph_pass_jumps(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
   uint8_t *jmp = s->jmp;
   real *jM = s->jM, *pk = s->pk;
   const real *x = p->x, *y = p->y, *dx = p->dx, *V = s->V;
-  real dmax = 0;
-  RHOD_KERNEL_LOOP_REDUCE(max, dmax)
-  for (long i = 0; i < nt; i++)
-    dmax = dx[i] > dmax ? dx[i] : dmax;
+  const real dmax = rhod_max_real(dx, nt);
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++)
     jmp[g] = 1;
