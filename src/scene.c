@@ -1625,6 +1625,9 @@ int rhod_scene_walls_move(const rhod_scene *s) {
   for (unsigned i = 0; s && i < s->n_walls; i++)
     if (s->walls[i].moving_edges)
       return 1;
+  for (unsigned i = 0; s && i < s->n_open; i++)
+    if (s->open[i].kind == RHOD_OPEN_INFLOW)
+      return 1;
   return 0;
 }
 

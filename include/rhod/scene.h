@@ -123,6 +123,41 @@ typedef struct {
   double omega;            /* free: initial angular velocity [1/s], default 0 */
 } rhod_body;
 
+/* open_boundaries.N.kind: how fluid crosses an open boundary (include/rhod/open.h) */
+typedef enum {
+  RHOD_OPEN_INFLOW = 0, /* the velocity is imposed (a law of time and a profile) */
+  RHOD_OPEN_OUTFLOW     /* the fluid leaves with the velocity it has there */
+} rhod_open_kind;
+
+/* open_boundaries.N.profile: the inflow velocity's shape along the segment */
+typedef enum {
+  RHOD_PROFILE_UNIFORM = 0, /* the same speed everywhere */
+  RHOD_PROFILE_PARABOLIC    /* 6 s (1 - s) times the speed, s in [0, 1] along the segment:
+                               0 at both ends, the given speed as its mean */
+} rhod_profile_kind;
+
+/* An open boundary: a straight segment through which fluid enters or leaves by continuous
+ * mass insertion and deletion (paper 000 Sec. 3.3, Eqs. 11-17; paper 001 Sec. 3.1,
+ * Eqs. 20-28). The loader resolves every default. */
+typedef struct {
+  char *name;             /* open_boundaries.N.name: default "openN" */
+  rhod_open_kind kind;    /* open_boundaries.N.kind (required) */
+  double from[2], to[2];  /* the segment's ends [m] (required) */
+  double normal[2];       /* unit normal pointing into the fluid: open_boundaries.N.normal's
+                             side, default the side of the domain's centre */
+  char *velocity;         /* inflow: the normal speed into the fluid [m/s] as an expression
+                             of t (libmatheval), the profile's mean; "0" by default; NULL
+                             for an outflow */
+  rhod_profile_kind profile; /* inflow: default uniform */
+  int surface_set;        /* open_boundaries.N.surface given */
+  double surface;         /* the free surface's level along -g (as fluid.N.surface): only
+                             the part of the segment below it is wet */
+  double dx;              /* the size of the particles it inserts [m], default particles.dx */
+  int phase;              /* multiphase: the phase it inserts (index), default 0; -1 for
+                             rhodsph */
+  unsigned line, col;     /* where the entry starts in the scene file (for messages) */
+} rhod_open_boundary;
+
 typedef enum {
   RHOD_PROBE_PRESSURE = 0,     /* Shepard-interpolated pressure at a point [Pa] */
   RHOD_PROBE_KINETIC_ENERGY,   /* sum 1/2 m |u|^2 [J/m] */
@@ -190,6 +225,8 @@ typedef struct {
   unsigned n_walls;
   rhod_body *bodies; /* bodies: rigid bodies (obstacles), in order */
   unsigned n_bodies;
+  rhod_open_boundary *open; /* open_boundaries: inflows and outflows, in order */
+  unsigned n_open;
   rhod_probe *probes;
   unsigned n_probes;
   double probe_every; /* probes.every [s]: sampling interval, default output_every/10 */
@@ -260,8 +297,8 @@ void rhod_warn(rhod_warn_buf *w, const char *fmt, ...) __attribute__((format(pri
  * blocks' bounding boxes (an upper estimate there). Before walls and domain cut it. */
 double rhod_scene_particle_estimate(const rhod_scene *s);
 
-/* Whether some wall edge moves (a non-zero walls.N.velocity) or some body is not fixed:
- * the ghosts then carry their wall's velocity (rhod_particles.gU). */
+/* Whether some wall edge moves (a non-zero walls.N.velocity), some body is not fixed or
+ * there is an inflow: the ghosts then carry their wall's velocity (rhod_particles.gU). */
 int rhod_scene_walls_move(const rhod_scene *s);
 
 #endif
