@@ -48,6 +48,27 @@ static inline void body_ghost(const real *K, real fx, real fy, const real *Tn, r
   }
 }
 
+/* An open boundary's velocity transform (open.h): an inflow's mirror carries the velocity
+ * its marker at tangential coordinate t imposes (T = 0, U = openu of the marker), an
+ * outflow's the fluid's as it is (T = I, U = 0: zero gradient across the boundary). */
+static inline void open_ghost(const real *S, const real *openu, real t, real *Tn, real *Un) {
+  if (S[7] == RHOD_SEG_INFLOW) {
+    const int count = (int)S[12];
+    int k = (int)floor(t / S[6] * (real)count);
+    k = k < 0 ? 0 : (k >= count ? count - 1 : k);
+    k += (int)S[11];
+    Tn[0] = 0, Tn[1] = 0, Tn[2] = 0, Tn[3] = 0;
+    Un[0] = openu[2 * k], Un[1] = openu[2 * k + 1];
+  } else {
+    const int count = (int)S[12];
+    int k = (int)floor(t / S[6] * (real)count);
+    k = k < 0 ? 0 : (k >= count ? count - 1 : k);
+    k += (int)S[11];
+    Tn[0] = 1, Tn[1] = 0, Tn[2] = 0, Tn[3] = 1;
+    Un[0] = openu[2 * k], Un[1] = openu[2 * k + 1];
+  }
+}
+
 /* Mirrors of (x, y) in the walls and bodies within R: positions, Jacobians J, velocity
  * transforms T (row-major 2x2), the moving walls' part U of the ghost velocity u' = T u + U,
  * and with bodies (A, B not NULL) the boundary's acceleration A and the body index B; M
@@ -60,9 +81,9 @@ static inline void body_ghost(const real *K, real fx, real fy, const real *Tn, r
  * overwrite each other's mirrors (tools/check_offload_frames.sh guards against any such
  * array in a kernel). */
 static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner, int ncorner,
-                               const real *circ, int ncirc, const real *kin, real x, real y, real R,
-                               real ms, real *gx, real *gy, real *J, real *T, real *U, real *A,
-                               int32_t *B, real *M) {
+                               const real *circ, int ncirc, const real *kin, const real *openu,
+                               real x, real y, real R, real ms, real *gx, real *gy, real *J,
+                               real *T, real *U, real *A, int32_t *B, real *M) {
   int n = 0;
   for (int s = 0; s < nseg; s++) {
     const real *S = seg + RHOD_SEG_STRIDE * s;
@@ -96,7 +117,9 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       Jn[1] = -2 * S[2] * S[3];
       Jn[2] = Jn[1];
       Jn[3] = 1 - 2 * S[3] * S[3];
-      if (S[7] != 0) {
+      if (S[7] >= RHOD_SEG_INFLOW) {
+        open_ghost(S, openu, t, Tn, Un);
+      } else if (S[7] != 0) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
         Un[0] = 2 * S[8], Un[1] = 2 * S[9];
       } else {
@@ -143,7 +166,34 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       Jn[1] = b0 * a1 + b1 * a3;
       Jn[2] = b1 * a0 + b3 * a1;
       Jn[3] = b1 * a1 + b3 * a3;
-      if (A_[7] != 0 || B_[7] != 0) {
+      if (A_[7] >= RHOD_SEG_INFLOW || B_[7] >= RHOD_SEG_INFLOW) {
+        /* a corner with an open boundary (open.h): the two mirrors composed, u' = T_b (T_a u +
+         * U_a) + U_b, each segment's own transform at the source's foot on it */
+        real Ta0, Ta1, Ta2, Ta3, Ua0, Ua1, Tb0, Tb1, Tb2, Tb3, Ub0, Ub1;
+        if (A_[7] >= RHOD_SEG_INFLOW) {
+          open_ghost(A_, openu, A_[4] * (x - A_[0]) + A_[5] * (y - A_[1]), Tn, Un);
+        } else if (A_[7] != 0) {
+          Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+          Un[0] = 2 * A_[8], Un[1] = 2 * A_[9];
+        } else {
+          Tn[0] = a0, Tn[1] = a1, Tn[2] = a1, Tn[3] = a3;
+          Un[0] = 0, Un[1] = 0;
+        }
+        Ta0 = Tn[0], Ta1 = Tn[1], Ta2 = Tn[2], Ta3 = Tn[3], Ua0 = Un[0], Ua1 = Un[1];
+        if (B_[7] >= RHOD_SEG_INFLOW) {
+          open_ghost(B_, openu, B_[4] * (x - B_[0]) + B_[5] * (y - B_[1]), Tn, Un);
+        } else if (B_[7] != 0) {
+          Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+          Un[0] = 2 * B_[8], Un[1] = 2 * B_[9];
+        } else {
+          Tn[0] = b0, Tn[1] = b1, Tn[2] = b1, Tn[3] = b3;
+          Un[0] = 0, Un[1] = 0;
+        }
+        Tb0 = Tn[0], Tb1 = Tn[1], Tb2 = Tn[2], Tb3 = Tn[3], Ub0 = Un[0], Ub1 = Un[1];
+        Tn[0] = Tb0 * Ta0 + Tb1 * Ta2, Tn[1] = Tb0 * Ta1 + Tb1 * Ta3;
+        Tn[2] = Tb2 * Ta0 + Tb3 * Ta2, Tn[3] = Tb2 * Ta1 + Tb3 * Ta3;
+        Un[0] = Tb0 * Ua0 + Tb1 * Ua1 + Ub0, Un[1] = Tb2 * Ua0 + Tb3 * Ua1 + Ub1;
+      } else if (A_[7] != 0 || B_[7] != 0) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
         /* our choice (docs/choices.md "moving walls at corners"): with T = -I the corner
          * ghost is a no-slip mirror of the corner, whose velocity is the mean of the
@@ -286,7 +336,7 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
   if (ensure_count(b, p->n + 1) != RHOD_OK)
     return -1;
   for (;;) {
-    const real *seg = b->seg, *circ = b->circ, *kin = b->kin;
+    const real *seg = b->seg, *circ = b->circ, *kin = b->kin, *openu = b->openu;
     const int32_t *corner = b->corner;
     int32_t *cnt = b->count;
     const real *x = p->x, *y = p->y, *dx = p->dx;
@@ -296,8 +346,8 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
         cnt[i] = 0;
         continue;
       }
-      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, x[i], y[i], ratio * dx[i],
-                            0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
+      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, openu, x[i], y[i],
+                            ratio * dx[i], 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)n + 1);
     if (total < 0)
@@ -316,9 +366,9 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       if (c == 0)
         continue;
       const long base = n + cnt[i];
-      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, gxo[i], gyo[i], ratio * gdx[i],
-                   m[i], gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base, gU + 2 * base,
-                   gA ? gA + 2 * base : NULL, gbody ? gbody + base : NULL, m + base);
+      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, openu, gxo[i], gyo[i],
+                   ratio * gdx[i], m[i], gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base,
+                   gU + 2 * base, gA ? gA + 2 * base : NULL, gbody ? gbody + base : NULL, m + base);
       for (long g = base; g < base + c; g++) {
         gdx[g] = gdx[i];
         gsrc[g] = (int32_t)i;
@@ -467,7 +517,8 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
       const real *S = seg + RHOD_SEG_STRIDE * s;
       const real rx = x[i] - S[0], ry = y[i] - S[1];
       const real d = S[2] * rx + S[3] * ry, t = S[4] * rx + S[5] * ry;
-      if (d <= 0 && d > -lim && t >= 0 && t <= S[6]) {
+      /* an open boundary lets particles through (open.h takes them out) */
+      if (S[7] < RHOD_SEG_INFLOW && d <= 0 && d > -lim && t >= 0 && t <= S[6]) {
         /* a body's boundary moves: the normal velocity relative to it is reflected */
         real wx = 0, wy = 0;
         if (S[10] >= 0) {
@@ -487,7 +538,8 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p) {
       const real *B = seg + RHOD_SEG_STRIDE * corner[2 * c + 1];
       const real da = A[2] * (x[i] - A[0]) + A[3] * (y[i] - A[1]);
       const real db = B[2] * (x[i] - B[0]) + B[3] * (y[i] - B[1]);
-      if (da <= 0 && da > -lim && db <= 0 && db > -lim) {
+      if (A[7] < RHOD_SEG_INFLOW && B[7] < RHOD_SEG_INFLOW && da <= 0 && da > -lim && db <= 0 &&
+          db > -lim) {
         x[i] -= 2 * da * A[2], y[i] -= 2 * da * A[3];
         const real db2 = B[2] * (x[i] - B[0]) + B[3] * (y[i] - B[1]); /* after the first */
         if (db2 < 0)

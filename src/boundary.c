@@ -94,6 +94,74 @@ static int push_shape(rhod_boundary *b, const rhod_shape *sh, int fluid_inside, 
   return RHOD_OK;
 }
 
+/* Whether a fluid wedge between segment A, leaving P along dA, and segment B through P
+ * needs a double mirror: A goes into B's fluid side and B continues from P into A's. */
+static int open_corner(const real *A, double px, double py, double dax, double day, const real *B) {
+  const double len = B[6], tol = 1e-9 * (1 + len);
+  const double rx = px - B[0], ry = py - B[1];
+  const double tb = rx * B[4] + ry * B[5], db = rx * B[2] + ry * B[3];
+  if (fabs(db) > tol || tb < -tol || tb > len + tol)
+    return 0; /* P is not on B */
+  if (B[2] * dax + B[3] * day <= 1e-9)
+    return 0;                                     /* A does not go into B's fluid */
+  const double along = A[2] * B[4] + A[3] * B[5]; /* n_A . t_B */
+  return (along > 1e-9 && tb < len - tol) || (along < -1e-9 && tb > tol);
+}
+
+/* The open boundaries' segments (open.h) after the walls': normal into the fluid, kind
+ * inflow or outflow, their markers (of the size of the particles each inserts) in [11] and
+ * [12], no refinement; and the corners where one meets a wall or another open boundary. */
+static int push_open(rhod_boundary *b, const rhod_scene *sc) {
+  real *s = realloc(b->seg, sizeof(real) * RHOD_SEG_STRIDE * (size_t)(b->nseg + (int)sc->n_open));
+  if (!s)
+    return RHOD_ERR_MEMORY;
+  b->seg = s;
+  const int first = b->nseg;
+  int nmark = 0;
+  for (unsigned k = 0; k < sc->n_open; k++) {
+    const rhod_open_boundary *O = &sc->open[k];
+    const double tx = O->to[0] - O->from[0], ty = O->to[1] - O->from[1], len = hypot(tx, ty);
+    real *S = s + RHOD_SEG_STRIDE * (first + (int)k);
+    const int count = (int)fmax(1, floor(len / O->dx + 0.5));
+    S[0] = (real)O->from[0], S[1] = (real)O->from[1];
+    S[2] = (real)O->normal[0], S[3] = (real)O->normal[1];
+    S[4] = (real)(tx / len), S[5] = (real)(ty / len);
+    S[6] = (real)len;
+    S[7] = O->kind == RHOD_OPEN_INFLOW ? RHOD_SEG_INFLOW : RHOD_SEG_OUTFLOW;
+    S[8] = 0, S[9] = 0, S[10] = -1;
+    S[11] = (real)nmark, S[12] = (real)count;
+    S[13] = 0;
+    nmark += count;
+  }
+  b->nseg += (int)sc->n_open;
+  b->nmark = nmark;
+  for (int a = first; a < b->nseg; a++) {
+    const real *A = b->seg + RHOD_SEG_STRIDE * a;
+    for (int end = 0; end < 2; end++) {
+      const double px = A[0] + (end ? A[6] * A[4] : 0), py = A[1] + (end ? A[6] * A[5] : 0);
+      const double dax = end ? -A[4] : A[4], day = end ? -A[5] : A[5];
+      for (int w = 0; w < b->nseg; w++) {
+        if (w == a || (w >= first && w < a)) /* a pair of open boundaries once */
+          continue;
+        if (!open_corner(A, px, py, dax, day, b->seg + RHOD_SEG_STRIDE * w))
+          continue;
+        int32_t *c = realloc(b->corner, sizeof(int32_t) * 2 * (size_t)(b->ncorner + 1));
+        if (!c)
+          return RHOD_ERR_MEMORY;
+        b->corner = c;
+        c[2 * b->ncorner] = w;
+        c[2 * b->ncorner + 1] = a;
+        b->ncorner++;
+      }
+    }
+  }
+  b->openu = calloc((size_t)(2 * nmark + 2), sizeof(real));
+  if (!b->openu)
+    return RHOD_ERR_MEMORY;
+  rhod_dev_map(b->openu, sizeof(real) * (size_t)(2 * nmark + 2));
+  return RHOD_OK;
+}
+
 int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2],
                        const double hi[2]) {
   memset(b, 0, sizeof *b);
@@ -106,6 +174,12 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
     const rhod_wall *W = &sc->walls[w];
     const int st = push_shape(b, &W->shape, W->fluid_inside, W->slip == RHOD_SLIP_NO, W->velocity,
                               W->moving_edges, -1, W->refine);
+    if (st != RHOD_OK)
+      return st;
+  }
+  b->open0 = b->nseg;
+  if (sc->n_open > 0) {
+    const int st = push_open(b, sc);
     if (st != RHOD_OK)
       return st;
   }
@@ -150,6 +224,9 @@ void rhod_boundary_free(rhod_boundary *b) {
   rhod_dev_unmap(b->circ, sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc);
   if (b->kin)
     rhod_dev_unmap(b->kin, sizeof(real) * RHOD_KIN_STRIDE * (size_t)b->nbody);
+  if (b->openu)
+    rhod_dev_unmap(b->openu, sizeof(real) * (size_t)(2 * b->nmark + 2));
+  free(b->openu);
   free(b->seg);
   free(b->corner);
   free(b->circ);

@@ -382,6 +382,7 @@ static int write_checkpoint(run_ctx *c, double next_out, double next_probe, char
   if (c->sim.ops->save)
     c->sim.ops->save(&c->sim, &ck);      /* the scheme's scalars */
   rhod_bodies_save(&c->sim.bodies, &ck); /* and the bodies' motion */
+  rhod_open_save(&c->sim.open, &ck);     /* and the open boundaries' bookkeeping */
   ck.picture_range[0] = c->pic_range[0];
   ck.picture_range[1] = c->pic_range[1];
   long pos = c->csv.f ? ftell(c->csv.f) : -1;
@@ -646,6 +647,8 @@ static int run(run_opts *o, const char *resume_out) {
         st = c.sim.ops->load(&c.sim, &ck, err, sizeof err);
       if (st == RHOD_OK) {
         st = rhod_bodies_load(&c.sim.bodies, &c.sim.bnd, &ck, err, sizeof err);
+        if (st == RHOD_OK)
+          st = rhod_open_load(&c.sim.open, &ck, err, sizeof err);
         if (st != RHOD_OK) { /* "OUT/checkpoint.rhod: reason" */
           char why[512];
           snprintf(why, sizeof why, "%s", err);

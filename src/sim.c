@@ -522,6 +522,13 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   st = s->ops->init(s, err, errlen);
   if (st != RHOD_OK)
     return st;
+  /* the open boundaries' markers (their segments are in the boundary already) */
+  st = rhod_open_init(&s->open, sc, &s->bnd, s->rho0, s->c0, err, errlen);
+  if (st != RHOD_OK) {
+    if (st == RHOD_ERR_MEMORY)
+      snprintf(err, errlen, "out of memory setting up the open boundaries");
+    return st;
+  }
   /* the probes the engine does not read must be the scheme's */
   for (unsigned i = 0; i < sc->n_probes; i++)
     if (!engine_probe(sc->probes[i].kind) && s->ops->probe(s, &sc->probes[i], NULL) != RHOD_OK) {
@@ -538,6 +545,8 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   if (st != RHOD_OK)
     return st;
   rhod_particles_to_device(p); /* the persistent state goes to the device */
+  if (s->open.n > 0)
+    s->open.mass0 = rhod_open_mass(p);
   const double glo[2] = {s->lo[0] - 2 * s->margin, s->lo[1] - 2 * s->margin};
   const double ghi[2] = {s->hi[0] + 2 * s->margin, s->hi[1] + 2 * s->margin};
   /* one grid made for the finest radius; coarser particles scan more cells (cells.h) */
@@ -560,6 +569,7 @@ void rhod_sim_free(rhod_sim *s) {
     s->ops->free(s);
   rhod_cells_free(&s->cells);
   rhod_bodies_free(&s->bodies);
+  rhod_open_free(&s->open);
   free(s->outline_start);
   free(s->outline_xy);
   s->outline_start = NULL, s->outline_xy = NULL;
@@ -598,8 +608,12 @@ static void wrap_periodic(rhod_sim *s) {
   }
 }
 
-int rhod_sim_prepare(rhod_sim *s, int sort) {
+/* rhod_sim_prepare for the state at time t (a stage's): the inflows' ghosts carry their
+ * velocity at t. */
+static int prepare_at(rhod_sim *s, int sort, double t) {
   rhod_particles *p = &s->p;
+  if (s->open.n > 0 && rhod_open_ghost_velocity(&s->open, &s->bnd, t, NULL, 0) != RHOD_OK)
+    return RHOD_ERR_UNSTABLE;
   if (sort) {
     wrap_periodic(s);
     p->ng = 0;
@@ -625,6 +639,8 @@ int rhod_sim_prepare(rhod_sim *s, int sort) {
   s->neighbours_fresh = 1;
   return RHOD_OK;
 }
+
+int rhod_sim_prepare(rhod_sim *s, int sort) { return prepare_at(s, sort, s->t); }
 
 /* Finds the first fluid particle that is not finite or out of the domain. */
 static int check_state(rhod_sim *s, char *err, size_t errlen) {
@@ -695,11 +711,16 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
     if (st != RHOD_OK)
       goto mem;
   }
+  /* the open boundaries' markers take the state of the step's start (open.h) */
+  st = rhod_open_state(&s->open, &s->bnd, p, &s->cells, s->sc->kernel, (real)s->sc->radius_ratio,
+                       *s->V, *s->P, s->t, err, errlen);
+  if (st != RHOD_OK)
+    return st;
   rhod_rk_begin(&s->rk, p);
   rhod_bodies_begin(&s->bodies);
   for (int stage = 0; stage < s->rk.stages; stage++) {
     if (stage > 0) {
-      st = rhod_sim_prepare(s, 0);
+      st = prepare_at(s, 0, s->t + (double)s->rk.table.c[stage - 1] * dt);
       if (st != RHOD_OK)
         goto mem;
     }
@@ -720,6 +741,11 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   }
   s->neighbours_fresh = 0;
   s->reflected += rhod_walls_guard(&s->bnd, p);
+  /* mass in and out through the open boundaries, before the domain check: what left
+   * through an outflow is gone */
+  st = rhod_open_exchange(&s->open, &s->bnd, p, dt, s->rho0);
+  if (st != RHOD_OK)
+    goto mem;
   s->t += dt;
   s->step++;
   s->particle_steps += (double)p->n;
@@ -742,6 +768,7 @@ int rhod_sim_stats(const rhod_sim *s, rhod_stat *out, int max) {
 void rhod_sim_report(const rhod_sim *s, long steps, rhod_warn_buf *w) {
   if (s->ops && s->ops->report)
     s->ops->report(s, steps, w);
+  rhod_open_report(&s->open, &s->p, w);
 }
 
 unsigned rhod_probe_columns(const rhod_scene *sc, char (*buf)[RHOD_PROBE_NAME_MAX],
@@ -964,6 +991,8 @@ int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
 static int wall_along(const rhod_boundary *b, double x, double y, const double d[2]) {
   for (int k = 0; k < b->nseg; k++) {
     const real *S = b->seg + RHOD_SEG_STRIDE * k;
+    if (S[7] >= RHOD_SEG_INFLOW) /* an open boundary holds nothing up */
+      continue;
     const double tx = S[4], ty = S[5], ax = S[0] - x, ay = S[1] - y;
     const double den = d[0] * ty - d[1] * tx;
     if (fabs(den) < 1e-12)

@@ -15,9 +15,17 @@
 #include <math.h>
 
 #define RHOD_SEG_STRIDE                                                                            \
-  14 /* ax, ay, nx, ny, tx, ty, length, noslip, ux, uy (a wall edge's velocity along itself,       \
-        walls.N.velocity; 0 at rest), body (its index, -1 for a wall), first, count (the           \
-        body's segments), refine (1: refinement criterion 4 near it) */
+  14 /* ax, ay, nx, ny, tx, ty, length, kind (RHOD_SEG_*), ux, uy (a wall edge's velocity along    \
+        itself, walls.N.velocity; 0 at rest), body (its index, -1 for a wall or an open            \
+        boundary), first, count (the body's segments; an open boundary's markers), refine (1:      \
+        refinement criterion 4 near it) */
+/* S[7], what a segment is: a wall or body with free or no slip, or an open boundary
+ * (open.h) whose mirrors carry the inflow's velocity (T = 0, U = the marker's) or the
+ * fluid's (an outflow: T = I, U = 0) */
+#define RHOD_SEG_FREE 0
+#define RHOD_SEG_NOSLIP 1
+#define RHOD_SEG_INFLOW 2
+#define RHOD_SEG_OUTFLOW 3
 #define RHOD_CIRC_STRIDE                                                                           \
   7 /* cx, cy, radius, side (+1 fluid inside, -1 outside), noslip, body (-1: a wall), refine */
 /* per body: G (x, y), its velocity (u, v), angular velocity Omega, G's acceleration (x, y),
@@ -39,6 +47,11 @@ typedef struct {
    * (host) hold them at zero displacement, kin their kinematics (device) */
   int nbody, nwallseg, nwallcirc;
   real *seg0, *circ0, *kin;
+  /* open boundaries (open.h): their segments are [open0, nwallseg), after the walls' and
+   * before the bodies'; openu (device) holds the velocity each of their nmark markers gives
+   * an inflow's ghosts, 2 per marker */
+  int open0, nmark;
+  real *openu;
 } rhod_boundary;
 
 /* Builds the wall segments, corners and circles of a scene, and the domain box. */
@@ -82,11 +95,10 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p);
  * wall guard puts back), or -1; *body its body's index. Host-side result of a device loop. */
 long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *body);
 
-/* A point moved off the walls: where (x, y) lies less than `keep` in front of a wall
- * (or behind it, by less than `back`), with its foot on the wall, it moves along the
- * wall normal to stand `keep` in front; walls in order, segments then circles. For
- * points placed near walls by a kernel (the APR split's children); inline, so that
- * device loops can call it. */
+/* A point moved off the walls (open boundaries aside): where (x, y) lies less than `keep` in front
+ * of a wall (or behind it, by less than `back`), with its foot on the wall, it moves along the wall
+ * normal to stand `keep` in front; walls in order, segments then circles. For points placed near
+ * walls by a kernel (the APR split's children); inline, so that device loops can call it. */
 typedef struct {
   real x, y;
 } rhod_point;
@@ -97,7 +109,7 @@ static inline rhod_point rhod_walls_keep_off(const real *seg, int nseg, const re
     const real *S = seg + RHOD_SEG_STRIDE * s;
     const real rx = x - S[0], ry = y - S[1];
     const real d = S[2] * rx + S[3] * ry, t = S[4] * rx + S[5] * ry;
-    if (d < keep && d > -back && t >= 0 && t <= S[6])
+    if (S[7] < RHOD_SEG_INFLOW && d < keep && d > -back && t >= 0 && t <= S[6])
       x += (keep - d) * S[2], y += (keep - d) * S[3];
   }
   for (int c = 0; c < ncirc; c++) {

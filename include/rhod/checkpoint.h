@@ -15,8 +15,9 @@
 #include "rhod/scene.h"
 #include <stdint.h>
 
-/* the scheme's and 9 a body (body.h) */
-#define RHOD_CK_MAX_EXTRAS (16 + 9 * RHOD_MAX_BODIES)
+/* the scheme's, 9 a body (body.h), and the open boundaries' (open.h: a carried imbalance per
+ * marker, at most 4096, and 7 totals) */
+#define RHOD_CK_MAX_EXTRAS (16 + 9 * RHOD_MAX_BODIES + 4096 + 7)
 /* The fixed fields of versions 2 to 6, in their file order, as the reader names them among
  * the extras: the APR totals (splits, merges: version 2; absorbed and the kinetic energy
  * merges and absorptions took out: version 4) and the stiffness limit's measure (1/s,

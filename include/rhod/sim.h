@@ -9,6 +9,7 @@
 #include "rhod/cells.h"
 #include "rhod/integrator.h"
 #include "rhod/io.h"
+#include "rhod/open.h"
 #include "rhod/particles.h"
 #include "rhod/scene.h"
 #include "rhod/scheme.h"
@@ -28,6 +29,9 @@ typedef struct {
   int bodies_more;         /* points inside other bodies than that too */
 } rhod_fill_stats;
 
+/* phases a scheme gives a reference density for (rhod_sim.rho0) */
+#define RHOD_SIM_PHASES 8
+
 typedef struct rhod_sim {
   const rhod_scene *sc;
   const rhod_scheme_ops *ops; /* the scheme (rhod_scheme_for) */
@@ -35,8 +39,12 @@ typedef struct rhod_sim {
   rhod_fill_stats *fill;      /* per fluid block, from rhod_sim_init */
   rhod_particles p;
   rhod_boundary bnd;
-  rhod_bodies bodies; /* the scene's bodies (body.h) */
-  double body_mu;     /* the dynamic viscosity of the bodies' force (the scheme's; 0 inviscid) */
+  rhod_bodies bodies;           /* the scene's bodies (body.h) */
+  rhod_open open;               /* the scene's open boundaries (open.h) */
+  double rho0[RHOD_SIM_PHASES]; /* the reference density of each phase (the scheme's; a
+                                   one-fluid scheme's at 0): open boundaries' nominal mass */
+  double c0[RHOD_SIM_PHASES];   /* and its speed of sound: the outflows' pressure relaxation */
+  double body_mu; /* the dynamic viscosity of the bodies' force (the scheme's; 0 inviscid) */
   unsigned *outline_start; /* the bodies' outlines of the last rhod_sim_fetch */
   double *outline_xy;
   rhod_cells cells;

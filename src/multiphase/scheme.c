@@ -92,6 +92,10 @@ static int mp_init(rhod_sim *s, char *err, size_t errlen) {
   rhod_particles *p = &s->p;
   rhod_mp *m = &ms->mp;
   int st = rhod_mp_init(m, &prm, p);
+  /* the open boundaries' nominal mass per phase (open.h) */
+  _Static_assert(RHOD_MP_MAX_PHASES <= RHOD_SIM_PHASES, "a reference density for every phase");
+  for (unsigned k = 0; k < sc->mp->n_phases && k < RHOD_SIM_PHASES; k++)
+    s->rho0[k] = sc->mp->phases[k].rho0, s->c0[k] = prm.ph[k].c;
   if (st == RHOD_ERR_SCENE) {
     snprintf(err, errlen, "%s: particles.kernel: not available with the multiphase scheme",
              sc->path);

@@ -94,7 +94,9 @@ static int rs_init(rhod_sim *s, char *err, size_t errlen) {
   rhod_particles *p = &s->p;
   rhod_sph *h = &rs->sph;
   int st = rhod_sph_init(h, sc, p);
-  s->body_mu = h->mu; /* the bodies' viscous force (body.h) */
+  s->body_mu = h->mu;                     /* the bodies' viscous force (body.h) */
+  s->rho0[0] = sc->rs ? sc->rs->rho0 : 0; /* the open boundaries' nominal mass (open.h) */
+  s->c0[0] = sc->rs ? sc->rs->c0 : 0;
   if (st == RHOD_OK)
     st = rhod_rk_add(&s->rk, p, &p->x, &h->vel, 2, 0);
   if (st == RHOD_OK)
