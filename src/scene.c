@@ -1643,6 +1643,20 @@ int rhod_scene_walls_move(const rhod_scene *s) {
   return 0;
 }
 
+/* What the schemes' sections say about open boundaries (scene_open.h): the level ratio and
+ * finest level of rhodsph's refinement, the multiphase scheme's phase names (names has
+ * room for RHOD_MP_MAX_PHASES). */
+static rhod_ob_levels open_levels(const rhod_scene *s, const char **names) {
+  rhod_ob_levels lv = {2.0, 30, names, 0};
+  if (s->rs) {
+    lv.ratio = rhod_pattern_ratio(s->rs->pattern);
+    lv.max_level = s->rs->levels > 1 ? s->rs->levels - 1 : 0;
+  }
+  for (unsigned k = 0; s->mp && k < s->mp->n_phases && k < RHOD_MP_MAX_PHASES; k++)
+    names[lv.n_phases++] = s->mp->phases[k].name;
+  return lv;
+}
+
 static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   char path[128];
   /* the scheme first: it decides which keys belong, and some defaults */
@@ -1825,7 +1839,9 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
     TRY(rhod_rs_load_refinement(c, d->refinement, s));
   /* open boundaries (src/scene_open.c): their own keys, after the phases and the
    * refinement levels (their dx and phase) */
-  TRY(rhod_ob_load(c, d->open, d->n_open, s));
+  const char *phase_names[RHOD_MP_MAX_PHASES];
+  const rhod_ob_levels lv = open_levels(s, phase_names);
+  TRY(rhod_ob_load(c, d->open, d->n_open, &lv, s));
   /* the default domain: bounding box of walls, fluid, the bodies where they stand at t = 0
    * and the open boundaries' segments */
   if (!s->has_domain) {
@@ -2197,7 +2213,9 @@ static ry_node *scene_tree(const rhod_scene *s) {
       tb_bool(&t, e, "refine", 0);
   }
   rhod_bd_tree(&t, root, s);
-  rhod_ob_tree(&t, root, s);
+  const char *phase_names[RHOD_MP_MAX_PHASES];
+  const rhod_ob_levels lv = open_levels(s, phase_names);
+  rhod_ob_tree(&t, root, s, &lv);
   m = tb_coll(&t, root, "probes", RY_MAP, 0);
   tb_num(&t, m, "every", s->probe_every);
   m = tb_coll(&t, m, "list", RY_SEQ, s->n_probes == 0);

@@ -10,8 +10,6 @@
 
 #include "scene_open.h"
 
-#include "rhod/multiphase/scene.h"
-#include "rhod/rhodsph/scene.h"
 #include "rhod/sim.h"
 #include "scene_bodies.h"
 
@@ -139,26 +137,23 @@ static const char *kind_word(rhod_open_kind k) {
 }
 
 /* open_boundaries.N.phase: a phase's name, or its index as a whole number */
-static int load_phase(lctx *c, const char *path, const rhod_scene *s, const char *text,
+static int load_phase(lctx *c, const char *path, const rhod_ob_levels *lv, const char *text,
                       int *index) {
-  *index = rhod_mp_phase_index(s->mp, text);
-  if (*index >= 0)
-    return RHOD_OK;
+  for (unsigned k = 0; k < lv->n_phases; k++)
+    if (strcmp(lv->phases[k], text) == 0)
+      return *index = (int)k, RHOD_OK;
   const size_t n = strspn(text, "0123456789");
-  if (n && n == strlen(text) && n < 4 && (unsigned)atoi(text) < s->mp->n_phases) {
-    *index = atoi(text);
-    return RHOD_OK;
-  }
+  if (n && n == strlen(text) && n < 4 && (unsigned)atoi(text) < lv->n_phases)
+    return *index = atoi(text), RHOD_OK;
   return rhod_sl_fail(c, path, "unknown phase '%s' (a phase's name or index, 0 to %u)", text,
-                      s->mp->n_phases - 1);
+                      lv->n_phases - 1);
 }
 
-/* open_boundaries.N.dx: particles.dx / e^k, e = 2 (the refinement pattern's ratio for
- * rhodsph), k a whole number below refinement.levels (rhodsph). */
-static int load_dx(lctx *c, const char *path, const rhod_scene *s, double dx, double *out) {
-  const int rhodsph = s->scheme == RHOD_SCHEME_RHODSPH && s->rs;
-  const double e = rhodsph ? rhod_pattern_ratio(s->rs->pattern) : 2.0;
-  const int kmax = rhodsph ? s->rs->levels - 1 : OPEN_MAX_HALVINGS;
+/* open_boundaries.N.dx: particles.dx / e^k, e the level ratio (2; rhodsph: its refinement
+ * pattern's), k a whole number, below refinement.levels for rhodsph. */
+static int load_dx(lctx *c, const char *path, const rhod_scene *s, const rhod_ob_levels *lv,
+                   double dx, double *out) {
+  const double e = lv->ratio;
   if (!(dx > 0))
     return rhod_sl_fail(c, path, "must be > 0, got %g", dx);
   const double k = round(log(s->dx / dx) / log(e));
@@ -167,16 +162,17 @@ static int load_dx(lctx *c, const char *path, const rhod_scene *s, double dx, do
                         "%g m is not particles.dx (%g m) / %g^k for a whole k >= 0 (a particle "
                         "size of a refinement level)",
                         dx, s->dx, e);
-  if (k > kmax)
+  if (k > lv->max_level)
     return rhod_sl_fail(c, path,
                         "%g m is particles.dx / %g^%d, finer than the finest level (refinement."
                         "levels: %d)",
-                        dx, e, (int)k, kmax + 1);
+                        dx, e, (int)k, lv->max_level + 1);
   *out = dx;
   return RHOD_OK;
 }
 
-static int load_open(lctx *c, const y_open *y, unsigned i, rhod_scene *s) {
+static int load_open(lctx *c, const y_open *y, unsigned i, const rhod_ob_levels *lv,
+                     rhod_scene *s) {
   rhod_open_boundary *o = &s->open[i];
   char base[32], path[96];
   snprintf(base, sizeof base, "open_boundaries.%u", i);
@@ -250,28 +246,28 @@ static int load_open(lctx *c, const y_open *y, unsigned i, rhod_scene *s) {
   o->dx = s->dx;
   if (y->dx) {
     snprintf(path, sizeof path, "%s.dx", base);
-    TRY(load_dx(c, path, s, *y->dx, &o->dx));
+    TRY(load_dx(c, path, s, lv, *y->dx, &o->dx));
   }
   /* phase: the multiphase scheme's */
   if (y->phase) {
     snprintf(path, sizeof path, "%s.phase", base);
     if (s->scheme != RHOD_SCHEME_MULTIPHASE)
       return rhod_sl_fail(c, path, "belongs to the multiphase scheme (scheme.name: multiphase)");
-    TRY(load_phase(c, path, s, y->phase, &o->phase));
+    TRY(load_phase(c, path, lv, y->phase, &o->phase));
   } else if (s->scheme == RHOD_SCHEME_MULTIPHASE) {
     o->phase = 0;
   }
   return RHOD_OK;
 }
 
-int rhod_ob_load(lctx *c, const y_open *open, unsigned n, rhod_scene *s) {
+int rhod_ob_load(lctx *c, const y_open *open, unsigned n, const rhod_ob_levels *lv, rhod_scene *s) {
   if (!n)
     return RHOD_OK;
   if (!(s->open = calloc(n, sizeof *s->open)))
     return rhod_sl_fail_oom(c);
   s->n_open = n;
   for (unsigned i = 0; i < n; i++)
-    TRY(load_open(c, &open[i], i, s));
+    TRY(load_open(c, &open[i], i, lv, s));
   return RHOD_OK;
 }
 
@@ -340,20 +336,6 @@ static int check_place(lctx *c, const rhod_scene *s, unsigned i) {
                           "a periodic axis across it: its normal [%g, %g] has a component "
                           "along %c, which domain.periodic wraps",
                           o->normal[0], o->normal[1], a ? 'y' : 'x');
-  /* the fluid behind it: points every particles.dx/2 along it, one dx behind */
-  const double L = hypot(o->to[0] - o->from[0], o->to[1] - o->from[1]);
-  const unsigned np = (unsigned)fmin(ceil(L / (0.5 * s->dx)), 1e6);
-  for (unsigned k = 0; k < (np ? np : 1); k++) {
-    const double f = (k + 0.5) / (np ? np : 1);
-    const double x = o->from[0] + f * (o->to[0] - o->from[0]) - s->dx * o->normal[0];
-    const double y = o->from[1] + f * (o->to[1] - o->from[1]) - s->dx * o->normal[1];
-    for (unsigned b = 0; b < s->n_fluid; b++)
-      if (rhod_shape_contains(&s->fluid[b].shape, x, y))
-        return rhod_sl_fail(c, path,
-                            "the fluid (fluid.%u) extends behind it: an open boundary lies on the "
-                            "fluid's edge, its normal pointing into the fluid (normal [%g, %g])",
-                            b, o->normal[0], o->normal[1]);
-  }
   /* the earlier open boundaries */
   for (unsigned j = 0; j < i; j++)
     if (segments_overlap(o->from, o->to, s->open[j].from, s->open[j].to, tol))
@@ -386,6 +368,20 @@ static int check_place(lctx *c, const rhod_scene *s, unsigned i) {
                           w);
     }
   }
+  /* the fluid behind it: points every particles.dx/2 along it, one dx behind */
+  const double L = hypot(o->to[0] - o->from[0], o->to[1] - o->from[1]);
+  const unsigned np = (unsigned)fmin(ceil(L / (0.5 * s->dx)), 1e6);
+  for (unsigned k = 0; k < (np ? np : 1); k++) {
+    const double f = (k + 0.5) / (np ? np : 1);
+    const double x = o->from[0] + f * (o->to[0] - o->from[0]) - s->dx * o->normal[0];
+    const double y = o->from[1] + f * (o->to[1] - o->from[1]) - s->dx * o->normal[1];
+    for (unsigned b = 0; b < s->n_fluid; b++)
+      if (rhod_shape_contains(&s->fluid[b].shape, x, y))
+        return rhod_sl_fail(c, path,
+                            "the fluid (fluid.%u) extends behind it: an open boundary lies on the "
+                            "fluid's edge, its normal pointing into the fluid (normal [%g, %g])",
+                            b, o->normal[0], o->normal[1]);
+  }
   return RHOD_OK;
 }
 
@@ -401,7 +397,7 @@ int rhod_ob_place(lctx *c, const y_open *open, rhod_scene *s) {
 
 /* ---- the scene as run --------------------------------------------------------------------- */
 
-void rhod_ob_tree(rhod_sl_tb *t, ry_node *root, const rhod_scene *s) {
+void rhod_ob_tree(rhod_sl_tb *t, ry_node *root, const rhod_scene *s, const rhod_ob_levels *lv) {
   if (!s->n_open) /* absent without open boundaries, so older checkpoints resume */
     return;
   ry_node *list = rhod_sl_coll(t, root, "open_boundaries", RY_SEQ, 0);
@@ -422,7 +418,7 @@ void rhod_ob_tree(rhod_sl_tb *t, ry_node *root, const rhod_scene *s) {
       rhod_sl_num(t, e, "surface", o->surface);
     rhod_sl_num(t, e, "dx", o->dx);
     if (s->scheme == RHOD_SCHEME_MULTIPHASE)
-      rhod_sl_word(t, e, "phase", s->mp->phases[o->phase].name);
+      rhod_sl_word(t, e, "phase", lv->phases[o->phase]);
   }
 }
 
