@@ -65,7 +65,8 @@ static const char *HELP_CHECK =
     "usage: rhod check SCENE [--set=KEY=VALUE]...\n"
     "Loads and validates the scene, builds the initial particles and prints their count,\n"
     "the memory they need, the first time step, an estimate of the number of steps and\n"
-    "one line per body (its motion and resolved centre, mass, inertia). Writes nothing.\n"
+    "one line per body (its motion and resolved centre, mass, inertia) and per open boundary\n"
+    "(its kind, length, resolved normal and inflow velocity). Writes nothing.\n"
     "  -h, --help   this text\n";
 
 /* ---- terminal output ------------------------------------------------------------------ */
@@ -969,6 +970,24 @@ static void print_bodies(const rhod_scene *sc) {
   }
 }
 
+/* One line per open boundary: its kind, name, length, resolved normal and, for an inflow,
+ * its velocity law and profile (src/scene_open.c). */
+static void print_open(const rhod_scene *sc) {
+  for (unsigned i = 0; i < sc->n_open; i++) {
+    const rhod_open_boundary *b = &sc->open[i];
+    const int in = b->kind == RHOD_OPEN_INFLOW;
+    printf("%s %s (open_boundaries.%u): %g m long, normal [%g, %g], dx %g m",
+           in ? "inflow" : "outflow", b->name, i,
+           hypot(b->to[0] - b->from[0], b->to[1] - b->from[1]), b->normal[0], b->normal[1], b->dx);
+    if (in)
+      printf(", velocity %s m/s (%s)", b->velocity,
+             b->profile == RHOD_PROFILE_PARABOLIC ? "parabolic, its mean" : "uniform");
+    if (b->surface_set)
+      printf(", surface %g m", b->surface);
+    printf("\n");
+  }
+}
+
 static int check_scene(run_opts *o) {
   char err[ERRLEN] = "";
   rhod_scene *sc = NULL;
@@ -1013,6 +1032,7 @@ static int check_scene(run_opts *o) {
   printf("outputs: %.0f snapshots, %.0f probe rows\n", floor(sc->t_end / sc->output_every) + 1,
          floor(sc->t_end / sc->probe_every) + 1);
   print_bodies(sc);
+  print_open(sc);
   if (nw > 0) {
     char *line = strtok(warn, "\n");
     while (line) {

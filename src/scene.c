@@ -17,6 +17,7 @@
 #include "rhodsph/scene_rs.h"
 #include "scene_bodies.h"
 #include "scene_module.h"
+#include "scene_open.h"
 #include "scene_yaml.h"
 
 #include <ctype.h>
@@ -178,6 +179,8 @@ typedef struct {
   unsigned n_walls;
   y_body *bodies; /* src/scene_bodies.c */
   unsigned n_bodies;
+  y_open *open; /* src/scene_open.c */
+  unsigned n_open;
   y_probes *probes;
   y_output *output;
   y_rs_refinement *refinement; /* the rhodsph scheme's section (src/rhodsph/scene_rs.c) */
@@ -430,6 +433,8 @@ static const cyaml_schema_field_t f_doc[] = {
     CYAML_FIELD_SEQUENCE_COUNT("walls", OPT, y_doc, walls, n_walls, &sch_wall, 0, CYAML_UNLIMITED),
     CYAML_FIELD_SEQUENCE_COUNT("bodies", OPT, y_doc, bodies, n_bodies, &rhod_bd_sch_body, 0,
                                CYAML_UNLIMITED),
+    CYAML_FIELD_SEQUENCE_COUNT("open_boundaries", OPT, y_doc, open, n_open, &rhod_ob_sch_open, 0,
+                               CYAML_UNLIMITED),
     CYAML_FIELD_MAPPING_PTR("probes", OPT, y_doc, probes, f_probes),
     CYAML_FIELD_MAPPING_PTR("output", OPT, y_doc, output, f_output),
     CYAML_FIELD_MAPPING_PTR("refinement", OPT, y_doc, refinement, rhod_rs_f_refinement),
@@ -582,6 +587,13 @@ int rhod_sl_fail_missing(lctx *c, const char *path, const char *key, const char 
 }
 
 int rhod_sl_fail_oom(lctx *c) { return fail_oom(c); }
+
+void rhod_sl_where(lctx *c, const char *path, unsigned *line, unsigned *col) {
+  const ry_node *n = ry_find_path(c->root, path);
+  const int file = n && n->origin < 0;
+  *line = file ? n->line : 0;
+  *col = file ? n->col : 0;
+}
 
 int rhod_sl_given(lctx *c, const char *section) {
   return c->root->kind == RY_MAP && ry_map_get(c->root, section);
@@ -1631,6 +1643,20 @@ int rhod_scene_walls_move(const rhod_scene *s) {
   return 0;
 }
 
+/* What the schemes' sections say about open boundaries (scene_open.h): the level ratio and
+ * finest level of rhodsph's refinement, the multiphase scheme's phase names (names has
+ * room for RHOD_MP_MAX_PHASES). */
+static rhod_ob_levels open_levels(const rhod_scene *s, const char **names) {
+  rhod_ob_levels lv = {2.0, 30, names, 0};
+  if (s->rs) {
+    lv.ratio = rhod_pattern_ratio(s->rs->pattern);
+    lv.max_level = s->rs->levels > 1 ? s->rs->levels - 1 : 0;
+  }
+  for (unsigned k = 0; s->mp && k < s->mp->n_phases && k < RHOD_MP_MAX_PHASES; k++)
+    names[lv.n_phases++] = s->mp->phases[k].name;
+  return lv;
+}
+
 static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   char path[128];
   /* the scheme first: it decides which keys belong, and some defaults */
@@ -1811,22 +1837,32 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
   /* refinement (paper 002 Sec. V) */
   if (!mpx)
     TRY(rhod_rs_load_refinement(c, d->refinement, s));
-  /* the default domain: bounding box of walls, fluid and the bodies where they stand at
-   * t = 0 */
+  /* open boundaries (src/scene_open.c): their own keys, after the phases and the
+   * refinement levels (their dx and phase) */
+  const char *phase_names[RHOD_MP_MAX_PHASES];
+  const rhod_ob_levels lv = open_levels(s, phase_names);
+  TRY(rhod_ob_load(c, d->open, d->n_open, &lv, s));
+  /* the default domain: bounding box of walls, fluid, the bodies where they stand at t = 0
+   * and the open boundaries' segments */
   if (!s->has_domain) {
-    for (unsigned i = 0; i < s->n_fluid + s->n_walls + s->n_bodies; i++) {
+    const unsigned nb = s->n_fluid + s->n_walls + s->n_bodies;
+    for (unsigned i = 0; i < nb + s->n_open; i++) {
       double lo[2], hi[2];
       if (i < s->n_fluid + s->n_walls)
         rhod_sl_shape_bbox(i < s->n_fluid ? &s->fluid[i].shape : &s->walls[i - s->n_fluid].shape,
                            lo, hi);
-      else
+      else if (i < nb)
         rhod_bd_bbox(&s->bodies[i - s->n_fluid - s->n_walls], lo, hi);
+      else
+        rhod_ob_bbox(&s->open[i - nb], lo, hi);
       for (int a = 0; a < 2; a++) {
         s->domain_min[a] = i ? fmin(s->domain_min[a], lo[a]) : lo[a];
         s->domain_max[a] = i ? fmax(s->domain_max[a], hi[a]) : hi[a];
       }
     }
   }
+  /* the open boundaries' normals (toward the domain's centre by default) and placement */
+  TRY(rhod_ob_place(c, d->open, s));
   /* probes */
   const y_probes *pr = d->probes;
   s->probe_every = pr && pr->every ? *pr->every : s->output_every / 10;
@@ -2177,6 +2213,9 @@ static ry_node *scene_tree(const rhod_scene *s) {
       tb_bool(&t, e, "refine", 0);
   }
   rhod_bd_tree(&t, root, s);
+  const char *phase_names[RHOD_MP_MAX_PHASES];
+  const rhod_ob_levels lv = open_levels(s, phase_names);
+  rhod_ob_tree(&t, root, s, &lv);
   m = tb_coll(&t, root, "probes", RY_MAP, 0);
   tb_num(&t, m, "every", s->probe_every);
   m = tb_coll(&t, m, "list", RY_SEQ, s->n_probes == 0);
@@ -2237,6 +2276,7 @@ void rhod_scene_free(rhod_scene *s) {
   for (unsigned i = 0; i < s->n_probes; i++)
     free(s->probes[i].name);
   rhod_bd_free(s);
+  rhod_ob_free(s);
   rhod_rs_scene_free(s->rs);
   rhod_mp_scene_free(s->mp);
   free(s->fluid);

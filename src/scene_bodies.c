@@ -384,9 +384,10 @@ static int law_parses(const char *text, size_t *bad) {
   return 1;
 }
 
-/* bodies.N.law.K: an expression of t alone (libmatheval), whose value, first and second
- * derivatives are finite at t = 0; *v0 its value there. */
-static int check_law(lctx *c, const char *path, const char *text, double *v0) {
+/* bodies.N.law.K (and open_boundaries.N.velocity, src/scene_open.c): an expression of t
+ * alone (libmatheval), whose value, first and second derivatives are finite at t = 0; *v0
+ * its value there. */
+int rhod_bd_check_law(lctx *c, const char *path, const char *text, double *v0) {
   const int cut = strlen(text) > 80;
   if (strlen(text) > LAW_MAX_LEN)
     return rhod_sl_fail(c, path, "longer than %d characters", LAW_MAX_LEN);
@@ -635,7 +636,7 @@ static int load_body(lctx *c, const y_body *y, unsigned i, rhod_scene *s) {
       if (!text[k])
         continue;
       snprintf(path, sizeof path, "%s.law.%s", base, dof_keys[k]);
-      TRY(check_law(c, path, text[k], &b->pose0[k]));
+      TRY(rhod_bd_check_law(c, path, text[k], &b->pose0[k]));
       if (!(b->law[k] = strdup(text[k])))
         return rhod_sl_fail_oom(c);
     }

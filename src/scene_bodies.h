@@ -40,6 +40,10 @@ extern const cyaml_schema_value_t rhod_bd_sch_body;
  * placement checks need them). */
 int rhod_bd_load(lctx *c, const y_body *bodies, unsigned n, rhod_scene *s);
 
+/* Checks a law: an expression of t alone in libmatheval syntax, whose value and first two
+ * derivatives are finite at t = 0 (*v0 its value there); else the one-line error at path. */
+int rhod_bd_check_law(lctx *c, const char *path, const char *text, double *v0);
+
 /* The bounding box of body b where it stands at t = 0 (for the default domain). */
 void rhod_bd_bbox(const rhod_body *b, double lo[2], double hi[2]);
 

@@ -62,6 +62,9 @@ int rhod_sl_fail(lctx *c, const char *path, const char *fmt, ...)
  * ("" for the top level). */
 int rhod_sl_fail_missing(lctx *c, const char *path, const char *key, const char *why);
 int rhod_sl_fail_oom(lctx *c);
+/* Where the node at a dotted path starts in the scene file: its line and column, 0 and 0
+ * when an override supplied it or the document lacks it. */
+void rhod_sl_where(lctx *c, const char *path, unsigned *line, unsigned *col);
 /* Whether the document (after the overrides) holds the top-level key `section`. */
 int rhod_sl_given(lctx *c, const char *section);
 /* One of rect / circle / polygon of the entry at path `base`, checked and copied into out

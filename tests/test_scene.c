@@ -397,6 +397,14 @@ static const struct {
     {"body_unknown_motion.yaml", 18, "bodies.0.motion", "invalid value 'floating'"},
     {"body_zero_inertia.yaml", 20, "bodies.0.inertia", "must be > 0, got 0"},
     {"body_zero_mass.yaml", 19, "bodies.0.mass", "must be > 0, got 0"},
+    /* open boundaries (src/scene_open.c; the others in test_scene_open.c) */
+    {"open_facing_fluid.yaml", 20, "open_boundaries.0", "the fluid (fluid.0) extends behind it"},
+    {"open_no_kind.yaml", 20, "open_boundaries.0.kind", "missing required key"},
+    {"open_on_wall.yaml", 20, "open_boundaries.0", "lies on walls.1: remove that wall edge"},
+    {"open_outside_domain.yaml", 20, "open_boundaries.0", "to [0, 0.3] lies outside the domain"},
+    {"open_overlap.yaml", 23, "open_boundaries.1", "overlaps open_boundaries.0"},
+    {"open_velocity_syntax.yaml", 23, "open_boundaries.0.velocity",
+     "'2*sin(t' is not an expression of t"},
 };
 
 static void test_bad_scenes(void) {
