@@ -91,6 +91,7 @@ int rhod_open_init(rhod_open *o, const rhod_scene *sc, const rhod_boundary *b, c
                        ? (level < D->surface ? o->rho0[k] * g * (D->surface - level) : 0)
                        : NAN;
     }
+    o->nout += D->kind == RHOD_OPEN_OUTFLOW;
     if (D->kind == RHOD_OPEN_INFLOW) {
       o->law[k] = evaluator_create(D->velocity ? D->velocity : "0");
       if (!o->law[k]) {
@@ -128,8 +129,10 @@ void rhod_open_free(rhod_open *o) {
 }
 
 void rhod_open_couple(rhod_open *o, int k, rhod_open_state_fn fn, void *ctx) {
-  if (k >= 0 && k < o->n)
+  if (k >= 0 && k < o->n) {
+    o->nout -= o->desc[k].kind == RHOD_OPEN_OUTFLOW && !o->fn[k] && fn;
     o->fn[k] = fn, o->ctx[k] = ctx;
+  }
 }
 
 /* Marker q's profile factor: 1, or 6 s (1 - s) at its centre (mean 1 over the segment). */

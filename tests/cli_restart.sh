@@ -136,6 +136,37 @@ rm -f "$T/q"/snapshot_0008.* "$T/q"/snapshot_0009.* "$T/q"/snapshot_0010.*
 expect 0 "bodies: resume after a crash" -- "$RHOD" resume "$T/q"
 check "bodies: resumed run identical to the uninterrupted one" -- same_outputs "$T/p" "$T/q"
 
+# 7. open boundaries (issue 52): a channel started from rest by an inflow's law, an
+#    outflow at the far end; the particles made and removed, the boundary particles' partial
+#    masses and every marker's carried imbalance come back from the checkpoint
+cat >"$T/open.yaml" <<'YAML'
+name: open_restart
+time: {end: 0.4, output_every: 0.05}
+particles: {dx: 0.02}
+physics: {rho0: 1000, c0: 20}
+domain: {min: [0, 0], max: [0.6, 0.2]}
+fluid:
+  - rect: {min: [0, 0], max: [0.6, 0.2]}
+walls:
+  - rect: {min: [-0.1, -0.1], max: [0.7, 0]}
+    fluid_inside: false
+    slip: no
+  - rect: {min: [-0.1, 0.2], max: [0.7, 0.3]}
+    fluid_inside: false
+open_boundaries:
+  - {kind: inflow, from: [0, 0], to: [0, 0.2], velocity: "1 - exp(-t/0.1)", profile: parabolic}
+  - {kind: outflow, from: [0.6, 0], to: [0.6, 0.2]}
+probes: {every: 0.01, list: [{mass: {}}, {kinetic_energy: {}}]}
+YAML
+expect 0 "open: uninterrupted run" -- "$RHOD" run "$T/open.yaml" -o "$T/r" --checkpoint-every 0.2
+check "open: particles were made and removed" -- grep -q "particles made, [1-9][0-9]* removed" "$T/r/run.log"
+cp -r "$T/r" "$T/s"
+rm -f "$T/s"/snapshot_0006.* "$T/s"/snapshot_0007.* "$T/s"/snapshot_0008.*
+expect 0 "open: resume after a crash" -- "$RHOD" resume "$T/s"
+check "open: resumed run identical to the uninterrupted one" -- same_outputs "$T/r" "$T/s"
+check "open: the same mass balance at the end" -- \
+  test "$(grep 'open boundaries' "$T/r/run.log")" = "$(grep 'open boundaries' "$T/s/run.log" | tail -2)"
+
 # 4. bad checkpoints: exit 10, one line naming the file and the reason
 cp -r "$T/a" "$T/d"
 printf 'X' | dd of="$T/d/checkpoint.rhod" bs=1 seek=5000 conv=notrunc 2>/dev/null

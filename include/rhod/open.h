@@ -50,6 +50,7 @@ typedef int (*rhod_open_state_fn)(void *ctx, int b, int k, double t, double x, d
 
 typedef struct {
   int n;                          /* open boundaries */
+  int nout;                       /* outflows among them (without a coupling callback) */
   const rhod_open_boundary *desc; /* the scene's */
   void **law;                     /* per boundary: the inflow speed's evaluator (NULL: outflow) */
   rhod_open_state_fn *fn;         /* per boundary: a coupling callback, NULL where none */
