@@ -230,11 +230,14 @@ int rhod_open_state(rhod_open *o, rhod_boundary *b, const rhod_particles *p, con
 
 /* ---- the exchange ---------------------------------------------------------------------- */
 
-/* A boundary particle's tangential overlap with marker j of its boundary (paper 001:
- * omega_is = |A_i cap A_s| / A_s), its cross-section [t - A/2, t + A/2] along the segment. */
-static double overlap(double t, double A, double w, int j) {
-  const double lo = fmax(t - A / 2, j * w), hi = fmin(t + A / 2, (j + 1) * w);
-  return hi > lo ? (hi - lo) / w : 0;
+/* The share of a boundary particle's cross-section [t - A/2, t + A/2] along the segment that
+ * lies over [a, b] (paper 001's omega_is = |A_i cap A_s| / A_s, over A_i instead: our choice,
+ * docs/choices.md "open boundaries: overlap", so that a particle's predicted change is
+ * shared out whole among the markers it covers, sum_s omega_is = 1, even when compression
+ * makes A_i differ from A_s). */
+static double overlap(double t, double A, double a, double b) {
+  const double lo = fmax(t - A / 2, a), hi = fmin(t + A / 2, b);
+  return hi > lo ? (hi - lo) / A : 0;
 }
 
 typedef struct {
@@ -276,7 +279,10 @@ int rhod_open_exchange(rhod_open *o, const rhod_boundary *b, rhod_particles *p, 
   for (long k = 0; k < nb; k++) {
     const real *F = bf + RHOD_OPEN_BF * k;
     m_old[k] = F[4];
-    mnew[k] = (double)F[4] + (double)F[7];
+    /* Eq. 23's change over the open boundary: the part of the cross-section beyond the
+     * segment's ends (over a wall) takes none (our choice, with the overlap above) */
+    const real *S = b->seg + RHOD_SEG_STRIDE * (int)F[0];
+    mnew[k] = (double)F[4] + overlap(F[1], F[3], 0, S[6]) * (double)F[7];
   }
   int st = RHOD_OK;
   for (int q = 0; q < o->nmark && st == RHOD_OK; q++) {
@@ -291,7 +297,7 @@ int rhod_open_exchange(rhod_open *o, const rhod_boundary *b, rhod_particles *p, 
       const real *F = bf + RHOD_OPEN_BF * k;
       if ((int)F[0] != seg)
         continue;
-      const double om = overlap(F[1], F[3], w, j);
+      const double om = overlap(F[1], F[3], j * w, (j + 1) * w);
       if (om <= 0)
         continue;
       own += om * (double)F[7];
