@@ -501,6 +501,17 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
     json_object_set_new(o, "kernels_ran_on", jstr(c->where));
     json_object_set_new(o, "scheme", jstr(s->ops ? s->ops->name : ""));
     json_object_set_new(o, "wall_reflections", json_integer(s->reflected));
+    if (s->open.n > 0) { /* the open boundaries' mass balance (open.h), kg per unit depth */
+      const rhod_open *ob = &s->open;
+      json_object_set_new(o, "open_mass_in", jnum(ob->taken_in));
+      json_object_set_new(o, "open_mass_out", jnum(ob->taken_out));
+      json_object_set_new(o, "open_prescribed_in", jnum(ob->prescribed_in));
+      json_object_set_new(o, "open_prescribed_out", jnum(ob->prescribed_out));
+      json_object_set_new(o, "open_fluid_mass_start", jnum(ob->mass0));
+      json_object_set_new(o, "open_fluid_mass", jnum(rhod_open_mass(&s->p)));
+      json_object_set_new(o, "open_particles_made", json_integer((json_int_t)ob->created));
+      json_object_set_new(o, "open_particles_removed", json_integer((json_int_t)ob->deleted));
+    }
     rhod_stat stats[RHOD_MAX_STATS];
     const int ns = rhod_sim_stats(s, stats, RHOD_MAX_STATS);
     for (int k = 0; k < ns; k++)
