@@ -508,7 +508,11 @@ static int write_summary(run_ctx *c, const char *status, const char *cause, doub
       json_object_set_new(o, "open_prescribed_in", jnum(ob->prescribed_in));
       json_object_set_new(o, "open_prescribed_out", jnum(ob->prescribed_out));
       json_object_set_new(o, "open_fluid_mass_start", jnum(ob->mass0));
-      json_object_set_new(o, "open_fluid_mass", jnum(rhod_open_mass(&s->p)));
+      const double mass = rhod_open_mass(&s->p);
+      json_object_set_new(o, "open_fluid_mass", jnum(mass));
+      /* the fluid's change less (in - out): round-off (the figures above have 9 digits) */
+      json_object_set_new(o, "open_balance_error",
+                          jnum(mass - ob->mass0 - (ob->taken_in - ob->taken_out)));
       json_object_set_new(o, "open_particles_made", json_integer((json_int_t)ob->created));
       json_object_set_new(o, "open_particles_removed", json_integer((json_int_t)ob->deleted));
     }
