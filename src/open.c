@@ -258,9 +258,26 @@ typedef struct {
 } birth;
 
 int rhod_open_exchange(rhod_open *o, const rhod_boundary *b, rhod_particles *p, double dt,
-                       const double *rho0_phase) {
+                       const double *rho0_phase, char *err, size_t errlen) {
   if (o->n == 0)
     return RHOD_OK;
+  /* a marker that could not keep up in the last step: more than a particle's mass waits at it (an
+   * inflow of more than one particle a step, an outflow drawn on with nothing left to give) */
+  for (int q = 0; q < o->nmark; q++) {
+    const int kb = o->mb[q];
+    const rhod_open_boundary *D = &o->desc[kb];
+    const double m0 = o->rho0[kb] * D->dx * D->dx;
+    if (fabs(o->pending[q]) > m0) {
+      snprintf(err, errlen,
+               "open boundary %s (open_boundaries.%d) is overwhelmed at (%g, %g): %.3g of a "
+               "particle's mass waits at one marker (%s); a smaller time step or a larger dx "
+               "there",
+               D->name, kb, o->mx[q], o->my[q], fabs(o->pending[q]) / m0,
+               o->pending[q] > 0 ? "more fluid comes in than a particle a step can take"
+                                 : "fluid is drawn out faster than it reaches the boundary");
+      return RHOD_ERR_UNSTABLE;
+    }
+  }
   const long nb = rhod_open_gather(o, b, p, rho0_phase);
   if (nb < 0)
     return RHOD_ERR_MEMORY;
@@ -319,12 +336,21 @@ int rhod_open_exchange(rhod_open *o, const rhod_boundary *b, rhod_particles *p, 
       M = dms - own;
     } else {
       /* an outflow (our choice, docs/choices.md "open boundaries: outflow"): what crosses
-       * leaves as it comes (Eq. 23), and the marker adds only the pressure relaxation
-       * RHOD_OPEN_KAPPA, rho_s A_s (u_s - u) . n dt. Imposing the whole of Eq. 20 there kept
-       * any gap the fluid brought to the boundary in the domain (the carried rest drains the
-       * next particle by the gap's mass): a channel started from rest stayed 0.4 % light. */
-      o->prescribed_out -= own;
-      M = 0;
+       * leaves as it comes (Eq. 23) and the marker imposes nothing of its own (the pressure
+       * relaxation RHOD_OPEN_KAPPA acts through its ghosts). Imposing the whole of Eq. 20
+       * there kept any gap the fluid brought to the boundary in the domain (the carried rest
+       * drains the next particle by the gap's mass): a channel started from rest stayed
+       * 0.4 % light. Where the fluid flows back in, Eq. 20 with the fluid's own velocity
+       * fills the boundary as an inflow would. */
+      const double back = un - (o->ukap[2 * q] * D->normal[0] + o->ukap[2 * q + 1] * D->normal[1]);
+      if (back > 0 && o->wet[q]) {
+        const double dms = o->rhos[q] * w * back * dt;
+        o->prescribed_out -= dms;
+        M = dms - own;
+      } else {
+        o->prescribed_out -= own;
+        M = 0;
+      }
     }
     /* with what an earlier step could not take */
     M += o->pending[q];
@@ -363,8 +389,8 @@ int rhod_open_exchange(rhod_open *o, const rhod_boundary *b, rhod_particles *p, 
          * moment they did (our choice; a released particle put in contact overlapped the
          * next one by up to u dt, and a uniform stream's mass varied by 0.2 %) */
         const double rho = o->rhos[q], A = D->dx * sqrt(o->rho0[kb] / rho);
-        const double lb = (M < o->rho0[kb] * D->dx * D->dx ? M : o->rho0[kb] * D->dx * D->dx) /
-                          (rho * A);
+        const double lb =
+            (M < o->rho0[kb] * D->dx * D->dx ? M : o->rho0[kb] * D->dx * D->dx) / (rho * A);
         for (int c = 0; c < nc; c++) {
           const int k = cl[c].k;
           if (mnew[k] >= (double)bf[RHOD_OPEN_BF * k + 6] * (1 - 1e-12))

@@ -750,7 +750,9 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
   s->reflected += rhod_walls_guard(&s->bnd, p);
   /* mass in and out through the open boundaries, before the domain check: what left
    * through an outflow is gone */
-  st = rhod_open_exchange(&s->open, &s->bnd, p, dt, s->rho0);
+  st = rhod_open_exchange(&s->open, &s->bnd, p, dt, s->rho0, err, errlen);
+  if (st == RHOD_ERR_UNSTABLE)
+    return st;
   if (st != RHOD_OK)
     goto mem;
   s->t += dt;

@@ -188,7 +188,7 @@ static void test_ghosts(void) {
       near += hypot(p->x[i], p->y[i] - 0.2 * c) < 0.08;
   CU_ASSERT_EQUAL(near, 2 * 13);
   CU_ASSERT_EQUAL(nin, 10 * 4 + near);
-      /* four columns, and the corners */ /* four columns, and the two corners' squares */
+  /* four columns, and the corners */ /* four columns, and the two corners' squares */
   CU_ASSERT_EQUAL(nout, 10 * 4 + near);
   CU_ASSERT_EQUAL(ncorner, near);
   run_close(&r);
@@ -214,6 +214,25 @@ static void test_outflow_relaxation(void) {
   run_close(&r);
 }
 
+/* An inflow faster than one particle a step (15 m/s against dx/dt = 10 m/s): the mass waiting
+ * at its markers grows until the run stops, naming the boundary; nothing is changed then. */
+static void test_overwhelmed(void) {
+  run r;
+  CU_ASSERT_FATAL(channel(&r, "overwhelmed", 0.6, "", "15", ""));
+  rhod_sim *s = r.sim;
+  char err[512] = "";
+  int st = RHOD_OK, k = 0;
+  for (; k < 20 && st == RHOD_OK; k++) {
+    CU_ASSERT_EQUAL_FATAL(rhod_sim_dt(s), RHOD_OK);
+    st = rhod_sim_step(s, s->dt, err, sizeof err);
+  }
+  CU_ASSERT_EQUAL(st, RHOD_ERR_UNSTABLE);
+  CU_ASSERT(k < 10);
+  CU_ASSERT_PTR_NOT_NULL(strstr(err, "open boundary open0 (open_boundaries.0) is overwhelmed"));
+  CU_ASSERT_PTR_NOT_NULL(strstr(err, "more fluid comes in"));
+  run_close(&r);
+}
+
 int main(void) {
   static const rhod_test_case cases[] = {
       {"mass in = mass out + change inside, to round-off", test_mass_exact},
@@ -222,6 +241,7 @@ int main(void) {
       {"a negative imbalance is carried and taken", test_negative_imbalance},
       {"ghosts: inflow velocity, outflow copies, corners", test_ghosts},
       {"an outflow relaxes the pressure to the ambient", test_outflow_relaxation},
+      {"an overwhelmed inflow stops the run, named", test_overwhelmed},
   };
   return RHOD_RUN_TESTS("open", cases);
 }

@@ -112,9 +112,11 @@ int rhod_open_state(rhod_open *o, rhod_boundary *b, const rhod_particles *p, con
 int rhod_open_ghost_velocity(rhod_open *o, rhod_boundary *b, double t, char *err, size_t errlen);
 
 /* The mass exchange of a step of size dt (after the integrator; the particles moved). Adds,
- * removes and moves particles (ghosts are dropped). Returns RHOD_OK or RHOD_ERR_MEMORY. */
+ * removes and moves particles (ghosts are dropped). Returns RHOD_OK, RHOD_ERR_MEMORY, or
+ * RHOD_ERR_UNSTABLE with a message when a boundary is overwhelmed (more than a particle's
+ * mass waits at one of its markers); the particles are then left as they were. */
 int rhod_open_exchange(rhod_open *o, const rhod_boundary *b, rhod_particles *p, double dt,
-                       const double *rho0_phase);
+                       const double *rho0_phase, char *err, size_t errlen);
 
 /* The fluid's mass, sum of m over [0, n) (a device reduction). */
 double rhod_open_mass(const rhod_particles *p);
