@@ -110,7 +110,10 @@ long rhod_open_gather(rhod_open *o, const rhod_boundary *b, const rhod_particles
      * l/2 - d (negative: the gap a particle in contact left behind, which it fills),
      * limited by 0 <= m + dm* <= m0 (Eq. 24) */
     real dm = -rho[i] * A * (l / 2 - d);
-    dm = dm < -m[i] ? -m[i] : (dm > m0 - m[i] ? m0 - m[i] : dm);
+    /* the upper limit holds growth only: a particle made heavier than m0 (a hydrostatic
+     * fill's m = rho dx^2) keeps its mass until it crosses (cases/open_channel_fs) */
+    const real room = m0 - m[i] > 0 ? m0 - m[i] : 0;
+    dm = dm < -m[i] ? -m[i] : (dm > room ? room : dm);
     real *F = bf + RHOD_OPEN_BF * k;
     bi[k] = (int32_t)i;
     F[0] = (real)s, F[1] = t, F[2] = d, F[3] = A, F[4] = m[i], F[5] = rho[i], F[6] = m0;

@@ -418,8 +418,8 @@ int rhod_open_exchange(rhod_open *o, const rhod_boundary *b, rhod_particles *p, 
     double m = mnew[k];
     if (m <= EMPTY_TOL * m0)
       m = 0, ndel++;
-    else if (m > m0 * (1 - 1e-12))
-      m = m0;
+    else if (m > m0 * (1 - 1e-12) && m_old[k] <= m0)
+      m = m0; /* filled (one heavier than m0 from the start keeps its mass) */
     const double dm = m - m_old[k];
     if (S[7] == RHOD_SEG_INFLOW)
       o->taken_in += dm;

@@ -106,9 +106,10 @@ int rhod_sim_prepare(rhod_sim *s, int sort);
 int rhod_sim_dt(rhod_sim *s);
 
 /* One step of size dt (s->dt clipped by the caller) with the scene's integrator, then the
- * scheme's end-of-step work. Checks the new state first: RHOD_ERR_UNSTABLE with the
- * particle and the cause in err when it is not finite or a particle left the domain; the
- * state is then left as computed (not written out). */
+ * scheme's end-of-step work, then the open boundaries' mass exchange (open.h). Checks the
+ * new state first: RHOD_ERR_UNSTABLE with the particle and the cause in err when it is not
+ * finite or a particle left the domain (other than behind an open boundary), or when an
+ * open boundary is overwhelmed; the state is then left as computed (not written out). */
 int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen);
 
 /* Probe columns: names (momentum probes give two, NAME_x and NAME_y, written into the
