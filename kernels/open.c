@@ -29,14 +29,15 @@ static int ensure_list(rhod_open *o, size_t nb) {
   return o->bi && o->bf ? RHOD_OK : RHOD_ERR_MEMORY;
 }
 
-/* The open segment of b particle (x, y) of size dx is a boundary particle of, or -1:
+/* The open segment of b that particle (x, y) of size dx is a boundary particle of, or -1:
  * its cuboid (paper 001 Sec. 3.1: cross-section A = dx (rho0/rho)^{1/2} in 2D along the
  * boundary, extent l = m/(rho A) across it) overlaps the segment tangentially and touches
  * or crosses the boundary (l/2 - d >= 0, d the depth of its centre), or it still lacks mass
- * (m < m0 = rho0 dx^2) within one size of the boundary. The nearest such segment. */
+ * (m < m0 = rho0 dx^2) within one size of the boundary. Of several, the one under its
+ * centre, then the nearest. */
 static inline int open_seg_of(const real *seg, int s0, int s1, real x, real y, real A, real l,
                               real dx, int partial) {
-  int best = -1;
+  int best = -1, bover = 0;
   real bd = 0;
   for (int s = s0; s < s1; s++) {
     const real *S = seg + RHOD_SEG_STRIDE * s;
@@ -47,8 +48,13 @@ static inline int open_seg_of(const real *seg, int s0, int s1, real x, real y, r
     const int touch = l / 2 - d >= -(real)1e-6 * dx;
     if (!(touch || (partial && d < dx)))
       continue;
-    if (best < 0 || fabs(d) < fabs(bd))
-      best = s, bd = d;
+    /* a segment under the particle's centre before one it only overlaps (two collinear
+     * segments meeting: cases/open_channel_fs, where the first one kept the particles that
+     * had drifted over the second, which then made new ones on top of them), then the
+     * nearer */
+    const int over = t >= 0 && t <= S[6];
+    if (best < 0 || over > bover || (over == bover && fabs(d) < fabs(bd)))
+      best = s, bd = d, bover = over;
   }
   return best;
 }
