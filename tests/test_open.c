@@ -84,7 +84,8 @@ static void test_mass_exact(void) {
   /* nobody beyond the open boundaries, every mass in (0, m0] */
   long bad = 0;
   for (size_t i = 0; i < s->p.n; i++)
-    bad += s->p.x[i] < 0 || s->p.x[i] > 0.6 || !(s->p.m[i] > 0) || s->p.m[i] > 0.4 * (1 + 1e-12);
+    bad += s->p.x[i] < -REL || s->p.x[i] > 0.6 + REL || !(s->p.m[i] > 0) ||
+           s->p.m[i] > 0.4 * (1 + REL);
   CU_ASSERT_EQUAL(bad, 0);
   run_close(&r);
 }
