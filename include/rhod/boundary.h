@@ -95,10 +95,12 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p);
  * wall guard puts back), or -1; *body its body's index. Host-side result of a device loop. */
 long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *body);
 
-/* A point moved off the walls (open boundaries aside): where (x, y) lies less than `keep` in front
- * of a wall (or behind it, by less than `back`), with its foot on the wall, it moves along the wall
- * normal to stand `keep` in front; walls in order, segments then circles. For points placed near
- * walls by a kernel (the APR split's children); inline, so that device loops can call it. */
+/* A point moved off the walls (pass walls and bodies, not the open boundaries' segments: a
+ * test of a segment's kind here made GCC 12's nvptx compiler fail, tree-nrv.cc:179): where
+ * (x, y) lies less than `keep` in front of a wall (or behind it, by less than `back`), with its
+ * foot on the wall, it moves along the wall normal to stand `keep` in front; walls in order,
+ * segments then circles. For points placed near walls by a kernel (the APR split's children);
+ * inline, so that device loops can call it. */
 typedef struct {
   real x, y;
 } rhod_point;
@@ -109,7 +111,7 @@ static inline rhod_point rhod_walls_keep_off(const real *seg, int nseg, const re
     const real *S = seg + RHOD_SEG_STRIDE * s;
     const real rx = x - S[0], ry = y - S[1];
     const real d = S[2] * rx + S[3] * ry, t = S[4] * rx + S[5] * ry;
-    if (S[7] < RHOD_SEG_INFLOW && d < keep && d > -back && t >= 0 && t <= S[6])
+    if (d < keep && d > -back && t >= 0 && t <= S[6])
       x += (keep - d) * S[2], y += (keep - d) * S[3];
   }
   for (int c = 0; c < ncirc; c++) {

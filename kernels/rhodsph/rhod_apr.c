@@ -48,7 +48,8 @@
  * children at a wall"); moved together they keep the pattern's spacing. Each child's
  * move carries to the next; a second round settles a corner whose walls are not at
  * right angles. Walls farther behind a child than back are not its walls (the far side
- * of a thin body). Over the locals seg, nseg, circ, ncirc (the walls of rhod_boundary). */
+ * of a thin body). Over the locals seg, nseg, circ, ncirc (the walls of rhod_boundary) and
+ * o0_, o1_ (its open boundaries' segments [o0_, o1_), which keep nothing off). */
 #define PATTERN_SHIFT(tri, xi, yi, ex, ey, ha, hb, rt, keep, back, shx, shy)                       \
   for (int r_ = 0; r_ < 2; r_++)                                                                   \
     for (int k_ = 0; k_ < ((tri) ? 3 : 4); k_++) {                                                 \
@@ -56,7 +57,9 @@
       const real ex_ = (ex), ey_ = (ey);                                                           \
       const real cx_ = (xi) + sa_ * ex_ - sb_ * ey_ + (shx);                                       \
       const real cy_ = (yi) + sa_ * ey_ + sb_ * ex_ + (shy);                                       \
-      const rhod_point q_ = rhod_walls_keep_off(seg, nseg, circ, ncirc, cx_, cy_, keep, back);     \
+      const rhod_point p_ = rhod_walls_keep_off(seg, o0_, circ, 0, cx_, cy_, keep, back);          \
+      const rhod_point q_ = rhod_walls_keep_off(seg + RHOD_SEG_STRIDE * o1_, nseg - o1_, circ,     \
+                                                ncirc, p_.x, p_.y, keep, back);                    \
       (shx) += q_.x - cx_, (shy) += q_.y - cy_;                                                    \
     }
 
@@ -200,7 +203,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real *kP = s->pk + RHOD_PK_P * st, *kux = s->pk + RHOD_PK_UX * st;
   const real *kuy = s->pk + RHOD_PK_UY * st, *krho = s->pk + RHOD_PK_RHO * st;
   const real *seg = b->seg, *circ = b->circ;
-  const int nseg = b->nseg, ncirc = b->ncirc;
+  const int nseg = b->nseg, ncirc = b->ncirc, o0_ = b->open0, o1_ = b->nwallseg;
   const uint8_t *reg = s->reg, *near = a->near, *near2 = a->near2;
   /* the free-surface particles alone (the region pass's subset cells, s->fsc) */
   const rhod_grid Gf = s->fsc.g;
@@ -725,7 +728,7 @@ long rhod_apr_split(rhod_apr *a, const rhod_sph *s, rhod_particles *p, const rho
   const real ieps = a->ieps, inn = 1 / (real)nsplit;
   const int tri = nsplit == 3;
   const real *seg = b->seg, *circ = b->circ;
-  const int nseg = b->nseg, ncirc = b->ncirc;
+  const int nseg = b->nseg, ncirc = b->ncirc, o0_ = b->open0, o1_ = b->nwallseg;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     if (mark[i] != 1)
