@@ -140,22 +140,22 @@ typedef enum {
  * mass insertion and deletion (paper 000 Sec. 3.3, Eqs. 11-17; paper 001 Sec. 3.1,
  * Eqs. 20-28). The loader resolves every default. */
 typedef struct {
-  char *name;             /* open_boundaries.N.name: default "openN" */
-  rhod_open_kind kind;    /* open_boundaries.N.kind (required) */
-  double from[2], to[2];  /* the segment's ends [m] (required) */
-  double normal[2];       /* unit normal pointing into the fluid: open_boundaries.N.normal's
-                             side, default the side of the domain's centre */
-  char *velocity;         /* inflow: the normal speed into the fluid [m/s] as an expression
-                             of t (libmatheval), the profile's mean; "0" by default; NULL
-                             for an outflow */
+  char *name;                /* open_boundaries.N.name: default "openN" */
+  rhod_open_kind kind;       /* open_boundaries.N.kind (required) */
+  double from[2], to[2];     /* the segment's ends [m] (required) */
+  double normal[2];          /* unit normal pointing into the fluid: open_boundaries.N.normal's
+                                side, default the side of the domain's centre */
+  char *velocity;            /* inflow: the normal speed into the fluid [m/s] as an expression
+                                of t (libmatheval), the profile's mean; "0" by default; NULL
+                                for an outflow */
   rhod_profile_kind profile; /* inflow: default uniform */
-  int surface_set;        /* open_boundaries.N.surface given */
-  double surface;         /* the free surface's level along -g (as fluid.N.surface): only
-                             the part of the segment below it is wet */
-  double dx;              /* the size of the particles it inserts [m], default particles.dx */
-  int phase;              /* multiphase: the phase it inserts (index), default 0; -1 for
-                             rhodsph */
-  unsigned line, col;     /* where the entry starts in the scene file (for messages) */
+  int surface_set;           /* open_boundaries.N.surface given */
+  double surface;            /* the free surface's level along -g (as fluid.N.surface): only
+                                the part of the segment below it is wet */
+  double dx;                 /* the size of the particles it inserts [m], default particles.dx */
+  int phase;                 /* multiphase: the phase it inserts (index), default 0; -1 for
+                                rhodsph */
+  unsigned line, col;        /* where the entry starts in the scene file (for messages) */
 } rhod_open_boundary;
 
 typedef enum {
