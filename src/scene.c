@@ -606,6 +606,23 @@ int rhod_sl_identifier(const char *s) {
   return strspn(s, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") == strlen(s);
 }
 
+int rhod_sl_list_name(lctx *c, const char *base, const char *given, const char *what,
+                      const char *prefix, unsigned i, char **out, char *path, size_t pathlen) {
+  if (given) {
+    snprintf(path, pathlen, "%s.name", base);
+    if (!rhod_sl_identifier(given))
+      return rhod_sl_fail(
+          c, path, "'%s' is not %s name (a letter or '_', then letters, digits, '_')", given, what);
+    *out = strdup(given);
+  } else {
+    snprintf(path, pathlen, "%s", base);
+    char def[48];
+    snprintf(def, sizeof def, "%s%u", prefix, i);
+    *out = strdup(def);
+  }
+  return *out ? RHOD_OK : rhod_sl_fail_oom(c);
+}
+
 /* ---- schema helpers -------------------------------------------------------------------- */
 
 static int is_seq_schema(const cyaml_schema_value_t *s) {

@@ -595,22 +595,7 @@ static int load_body(lctx *c, const y_body *y, unsigned i, rhod_scene *s) {
   snprintf(base, sizeof base, "bodies.%u", i);
   TRY(rhod_sl_load_shape(c, base, y->rect, y->circle, y->polygon, y->n_polygon, &b->shape));
   /* name: an identifier, unique among the bodies (probes.csv columns NAME_Fx ...) */
-  if (y->name) {
-    snprintf(path, sizeof path, "%s.name", base);
-    if (!rhod_sl_identifier(y->name))
-      return rhod_sl_fail(c, path,
-                          "'%s' is not a body name (a letter or '_', then letters, "
-                          "digits, '_')",
-                          y->name);
-    b->name = strdup(y->name);
-  } else {
-    snprintf(path, sizeof path, "%s", base);
-    char def[32];
-    snprintf(def, sizeof def, "body%u", i);
-    b->name = strdup(def);
-  }
-  if (!b->name)
-    return rhod_sl_fail_oom(c);
+  TRY(rhod_sl_list_name(c, base, y->name, "a body", "body", i, &b->name, path, sizeof path));
   for (unsigned j = 0; j < i; j++)
     if (strcmp(b->name, s->bodies[j].name) == 0)
       return rhod_sl_fail(c, path, "the name '%s' is also bodies.%u's (names must differ)", b->name,

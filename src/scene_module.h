@@ -78,6 +78,11 @@ double rhod_sl_shape_area(const rhod_shape *sh);
 int rhod_sl_segments_meet(const double *a, const double *b, const double *p, const double *q);
 /* Whether a string is a valid identifier: [A-Za-z_][A-Za-z0-9_]*, at most 64 characters. */
 int rhod_sl_identifier(const char *s);
+/* The name of entry i of a list section at `base` (bodies.N, open_boundaries.N): `given`
+ * when it is an identifier (else the one-line error "'x' is not WHAT name ..."), or prefix
+ * followed by i; strdup'd into *out. path gets the key a message about it names. */
+int rhod_sl_list_name(lctx *c, const char *base, const char *given, const char *what,
+                      const char *prefix, unsigned i, char **out, char *path, size_t pathlen);
 
 /* Writing the scene as run: a tree of ry_nodes; an allocation failure sets oom and every
  * later call does nothing. */

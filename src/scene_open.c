@@ -182,22 +182,8 @@ static int load_open(lctx *c, const y_open *y, unsigned i, const rhod_ob_levels 
   memcpy(o->to, y->to, sizeof o->to);
   o->phase = -1;
   /* name: an identifier, unique among the open boundaries */
-  if (y->name) {
-    snprintf(path, sizeof path, "%s.name", base);
-    if (!rhod_sl_identifier(y->name))
-      return rhod_sl_fail(c, path,
-                          "'%s' is not an open boundary name (a letter or '_', then letters, "
-                          "digits, '_')",
-                          y->name);
-    o->name = strdup(y->name);
-  } else {
-    snprintf(path, sizeof path, "%s", base);
-    char def[32];
-    snprintf(def, sizeof def, "open%u", i);
-    o->name = strdup(def);
-  }
-  if (!o->name)
-    return rhod_sl_fail_oom(c);
+  TRY(rhod_sl_list_name(c, base, y->name, "an open boundary", "open", i, &o->name, path,
+                        sizeof path));
   for (unsigned j = 0; j < i; j++)
     if (strcmp(o->name, s->open[j].name) == 0)
       return rhod_sl_fail(c, path, "the name '%s' is also open_boundaries.%u's (names must differ)",
