@@ -599,6 +599,29 @@ int rhod_sl_given(lctx *c, const char *section) {
   return c->root->kind == RY_MAP && ry_map_get(c->root, section);
 }
 
+/* A shape's vertices, counter-clockwise (a rect's from its lower-left corner); NULL for a
+ * circle or when out of memory. */
+double (*rhod_sl_shape_vertices(const rhod_shape *sh, unsigned *n))[2] {
+  *n = 0;
+  if (sh->kind == RHOD_SHAPE_CIRCLE)
+    return NULL;
+  const unsigned np = sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points;
+  double(*p)[2] = malloc(np * sizeof *p);
+  if (!p)
+    return NULL;
+  if (sh->kind == RHOD_SHAPE_RECT) {
+    const double q[4][2] = {{sh->min[0], sh->min[1]},
+                            {sh->max[0], sh->min[1]},
+                            {sh->max[0], sh->max[1]},
+                            {sh->min[0], sh->max[1]}};
+    memcpy(p, q, sizeof q);
+  } else {
+    memcpy(p, sh->points, np * sizeof *p);
+  }
+  *n = np;
+  return p;
+}
+
 int rhod_sl_identifier(const char *s) {
   static const char alpha[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ_";
   if (!s || !s[0] || !strchr(alpha, s[0]) || strlen(s) > NAME_MAX_LEN)

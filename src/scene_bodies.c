@@ -72,29 +72,6 @@ const cyaml_schema_value_t rhod_bd_sch_body = {
 
 /* ---- geometry --------------------------------------------------------------------------- */
 
-/* A shape's vertices, counter-clockwise (a rect's from its lower-left corner); NULL for a
- * circle or when out of memory. */
-static double (*shape_vertices(const rhod_shape *sh, unsigned *n))[2] {
-  *n = 0;
-  if (sh->kind == RHOD_SHAPE_CIRCLE)
-    return NULL;
-  const unsigned np = sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points;
-  double(*p)[2] = malloc(np * sizeof *p);
-  if (!p)
-    return NULL;
-  if (sh->kind == RHOD_SHAPE_RECT) {
-    const double q[4][2] = {{sh->min[0], sh->min[1]},
-                            {sh->max[0], sh->min[1]},
-                            {sh->max[0], sh->max[1]},
-                            {sh->min[0], sh->max[1]}};
-    memcpy(p, q, sizeof q);
-  } else {
-    memcpy(p, sh->points, np * sizeof *p);
-  }
-  *n = np;
-  return p;
-}
-
 /* Centroid of a simple counter-clockwise polygon (area-weighted), about its first vertex
  * for round-off. */
 static void polygon_centroid(const double (*p)[2], unsigned n, double G[2]) {
@@ -154,7 +131,7 @@ static int make_outline(const rhod_shape *sh, const double G[2], const double po
       o->lo[a] = o->c[a] - o->r, o->hi[a] = o->c[a] + o->r;
     return 1;
   }
-  if (!(o->p = shape_vertices(sh, &o->n)))
+  if (!(o->p = rhod_sl_shape_vertices(sh, &o->n)))
     return 0;
   for (unsigned k = 0; k < o->n; k++) {
     if (moved) {
@@ -564,7 +541,7 @@ static int load_free(lctx *c, const char *base, const y_body *y, rhod_body *b) {
     b->inertia = b->mass * (0.5 * r * r + dx * dx + dy * dy);
   } else {
     unsigned n;
-    double(*p)[2] = shape_vertices(&b->shape, &n);
+    double(*p)[2] = rhod_sl_shape_vertices(&b->shape, &n);
     if (!p)
       return rhod_sl_fail_oom(c);
     b->inertia = polygon_polar_moment((const double(*)[2])p, n, b->center) * b->mass / area;

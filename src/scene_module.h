@@ -76,6 +76,9 @@ void rhod_sl_shape_bbox(const rhod_shape *sh, double lo[2], double hi[2]);
 double rhod_sl_shape_area(const rhod_shape *sh);
 /* Whether segments a-b and p-q meet (cross or touch). */
 int rhod_sl_segments_meet(const double *a, const double *b, const double *p, const double *q);
+/* A rect's or polygon's vertices, counter-clockwise (a rect's from its lower-left corner),
+ * malloc'd, n of them; NULL for a circle or when out of memory. */
+double (*rhod_sl_shape_vertices(const rhod_shape *sh, unsigned *n))[2];
 /* Whether a string is a valid identifier: [A-Za-z_][A-Za-z0-9_]*, at most 64 characters. */
 int rhod_sl_identifier(const char *s);
 /* The name of entry i of a list section at `base` (bodies.N, open_boundaries.N): `given`

@@ -102,22 +102,11 @@ static int segments_collinear_overlap(const double *a, const double *b, const do
  * about G (a body where it stands at t = 0); NULL for a circle or when out of memory. */
 static double (*edges_of(const rhod_shape *sh, const double *G, const double *pose,
                          unsigned *n))[2] {
+  unsigned np;
+  double(*p)[2] = rhod_sl_shape_vertices(sh, &np);
   *n = 0;
-  if (sh->kind == RHOD_SHAPE_CIRCLE)
-    return NULL;
-  const unsigned np = sh->kind == RHOD_SHAPE_RECT ? 4 : sh->n_points;
-  double(*p)[2] = malloc(np * sizeof *p);
   if (!p)
     return NULL;
-  if (sh->kind == RHOD_SHAPE_RECT) {
-    const double q[4][2] = {{sh->min[0], sh->min[1]},
-                            {sh->max[0], sh->min[1]},
-                            {sh->max[0], sh->max[1]},
-                            {sh->min[0], sh->max[1]}};
-    memcpy(p, q, sizeof q);
-  } else {
-    memcpy(p, sh->points, np * sizeof *p);
-  }
   if (pose && (pose[0] != 0 || pose[1] != 0 || pose[2] != 0)) {
     const double cs = cos(pose[2]), sn = sin(pose[2]);
     for (unsigned k = 0; k < np; k++) {
