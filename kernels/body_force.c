@@ -25,13 +25,23 @@ static int viscous(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c
   const real Rmax = ratio * rhod_max_real(dx, n);
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx, *gbody = p->gbody;
-  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy;
+  const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *gTv = p->gTv, *gUv = p->gUv;
+  const int32_t *gsrc = p->gsrc;
   real *f = bb->fghost;
   RHOD_GATHER_LOOP
   for (long g = n; g < nt; g++) {
     real fx = 0, fy = 0;
     if (gbody[g] >= 0) {
-      const real xj = x[g], yj = y[g], Vj = V[g], uxj = ux[g], uyj = uy[g];
+      /* the ghost's velocity in the viscous terms: through gTv, gUv where a wall or body is
+       * no-slip (boundary.h), else the one it carries */
+      real uxj = ux[g], uyj = uy[g];
+      if (gTv) {
+        const real *Tv = gTv + 4 * g;
+        const long k = gsrc[g];
+        uxj = Tv[0] * ux[k] + Tv[1] * uy[k] + gUv[2 * g];
+        uyj = Tv[2] * ux[k] + Tv[3] * uy[k] + gUv[2 * g + 1];
+      }
+      const real xj = x[g], yj = y[g], Vj = V[g];
       RHOD_FOR_NEIGHBOURS(G, CS, CI, xj, yj, Rmax, i) {
         /* the fluid and its periodic images (gbody -2): each pair once, from the body's
          * own ghosts (their periodic images carry -1) */

@@ -32,10 +32,10 @@ void rhod_ghosts_map_vector(const rhod_particles *p, real *v) {
   }
 }
 
-void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy) {
+static void map_velocity(const rhod_particles *p, const real *gT, const real *gU, real *vx,
+                         real *vy) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   const int32_t *gsrc = p->gsrc;
-  const real *gT = p->gT, *gU = p->gU;
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++) {
     const long k = gsrc[g];
@@ -44,4 +44,15 @@ void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy) {
     vx[g] = T[0] * a + T[1] * b + gU[2 * g];
     vy[g] = T[2] * a + T[3] * b + gU[2 * g + 1];
   }
+}
+
+void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy) {
+  map_velocity(p, p->gT, p->gU, vx, vy);
+}
+
+void rhod_ghosts_map_velocity_viscous(const rhod_particles *p, real *vx, real *vy) {
+  if (p->gTv)
+    map_velocity(p, p->gTv, p->gUv, vx, vy);
+  else
+    map_velocity(p, p->gT, p->gU, vx, vy);
 }

@@ -69,13 +69,66 @@ static inline void open_ghost(const real *S, const real *openu, real t, real *Tn
   }
 }
 
+/* One segment's velocity map at a corner (wall_mirrors): an open boundary's (open_ghost) at
+ * the source's foot, a no-slip wall's -I and 2 u_wall where `wall` asks for the walls'
+ * own conditions, else the free-slip mirror J (a0, a1; a1, a3), U = 0. */
+static inline void corner_seg_map(const real *S, const real *openu, real x, real y, int wall,
+                                  real a0, real a1, real a3, real *Tn, real *Un) {
+  if (S[7] >= RHOD_SEG_INFLOW) {
+    open_ghost(S, openu, S[4] * (x - S[0]) + S[5] * (y - S[1]), Tn, Un);
+  } else if (wall && S[7] != 0) {
+    Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+    Un[0] = 2 * S[8], Un[1] = 2 * S[9];
+  } else {
+    Tn[0] = a0, Tn[1] = a1, Tn[2] = a1, Tn[3] = a3;
+    Un[0] = 0, Un[1] = 0;
+  }
+}
+
+/* The velocity map of the double mirror of (x, y) in segments a then b (position Jacobian
+ * Jn): the walls' own conditions where `wall` is set, else their free-slip mirrors (open
+ * boundaries keep theirs). */
+static inline void corner_map(const real *A_, const real *B_, const real *openu, real x, real y,
+                              const real *Jn, int wall, real *Tn, real *Un) {
+  const real a0 = 1 - 2 * A_[2] * A_[2], a1 = -2 * A_[2] * A_[3], a3 = 1 - 2 * A_[3] * A_[3];
+  const real b0 = 1 - 2 * B_[2] * B_[2], b1 = -2 * B_[2] * B_[3], b3 = 1 - 2 * B_[3] * B_[3];
+  if (A_[7] >= RHOD_SEG_INFLOW || B_[7] >= RHOD_SEG_INFLOW) {
+    /* a corner with an open boundary (open.h): the two mirrors composed, u' = T_b (T_a u +
+     * U_a) + U_b, each segment's own transform at the source's foot on it */
+    corner_seg_map(A_, openu, x, y, wall, a0, a1, a3, Tn, Un);
+    const real Ta0 = Tn[0], Ta1 = Tn[1], Ta2 = Tn[2], Ta3 = Tn[3], Ua0 = Un[0], Ua1 = Un[1];
+    corner_seg_map(B_, openu, x, y, wall, b0, b1, b3, Tn, Un);
+    const real Tb0 = Tn[0], Tb1 = Tn[1], Tb2 = Tn[2], Tb3 = Tn[3], Ub0 = Un[0], Ub1 = Un[1];
+    Tn[0] = Tb0 * Ta0 + Tb1 * Ta2, Tn[1] = Tb0 * Ta1 + Tb1 * Ta3;
+    Tn[2] = Tb2 * Ta0 + Tb3 * Ta2, Tn[3] = Tb2 * Ta1 + Tb3 * Ta3;
+    Un[0] = Tb0 * Ua0 + Tb1 * Ua1 + Ub0, Un[1] = Tb2 * Ua0 + Tb3 * Ua1 + Ub1;
+  } else if (wall && (A_[7] != 0 || B_[7] != 0)) {
+    Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
+    /* our choice (docs/choices.md "moving walls at corners"): with T = -I the corner
+     * ghost is a no-slip mirror of the corner, whose velocity is the mean of the
+     * no-slip walls meeting there (a free-slip wall imposes none): U = 2 u_corner.
+     * Composing the two mirrors, T_b (T_a u + U_a) + U_b, would give -U_a + U_b for
+     * two no-slip walls: the lid's velocity reversed at one of a cavity's corners */
+    const real na = A_[7] != 0 ? 1 : 0, nb = B_[7] != 0 ? 1 : 0;
+    Un[0] = 2 * (na * A_[8] + nb * B_[8]) / (na + nb);
+    Un[1] = 2 * (na * A_[9] + nb * B_[9]) / (na + nb);
+  } else {
+    for (int k = 0; k < 4; k++)
+      Tn[k] = Jn[k];
+    Un[0] = 0, Un[1] = 0; /* T_b (T_a u + 0) + 0: free slip on both */
+  }
+}
+
 /* Mirrors of (x, y) in the walls and bodies within R: positions, Jacobians J, velocity
  * transforms T (row-major 2x2), the moving walls' part U of the ghost velocity u' = T u + U,
  * and with bodies (A, B not NULL) the boundary's acceleration A and the body index B; M
  * the ghost's mass from the source's ms. Free slip: T = J (normal velocity reversed), U = 0
  * for a wall (a wall's motion along itself does not act on a free-slip fluid); no slip:
  * T = -I (both components reversed), U = 2 u_wall, so that the mean of u and u' is the
- * wall's velocity. Returns the count; with gx NULL it only counts. The outputs are written
+ * wall's velocity. With Tv not NULL (a scene with a no-slip wall or body), (T, U) is the
+ * free-slip map of every wall and (Tv, Uv) the map the wall's condition asks for, which
+ * only the viscous terms read (docs/choices.md "no slip in the viscous term only").
+ * Returns the count; with gx NULL it only counts. The outputs are written
  * straight into the ghost arrays (gx[k], J[4k]): a local array here would sit in GCC 12's
  * per-warp nvptx frame, shared by the 32 lanes of a simd loop, and the lanes would
  * overwrite each other's mirrors (tools/check_offload_frames.sh guards against any such
@@ -83,7 +136,7 @@ static inline void open_ghost(const real *S, const real *openu, real t, real *Tn
 static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner, int ncorner,
                                const real *circ, int ncirc, const real *kin, const real *openu,
                                real x, real y, real R, real ms, real *gx, real *gy, real *J,
-                               real *T, real *U, real *A, int32_t *B, real *M) {
+                               real *T, real *U, real *Tv, real *Uv, real *A, int32_t *B, real *M) {
   int n = 0;
   for (int s = 0; s < nseg; s++) {
     const real *S = seg + RHOD_SEG_STRIDE * s;
@@ -119,13 +172,26 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       Jn[3] = 1 - 2 * S[3] * S[3];
       if (S[7] >= RHOD_SEG_INFLOW) {
         open_ghost(S, openu, t, Tn, Un);
-      } else if (S[7] != 0) {
+      } else if (S[7] != 0 && !Tv) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
         Un[0] = 2 * S[8], Un[1] = 2 * S[9];
       } else {
         for (int k = 0; k < 4; k++)
           Tn[k] = Jn[k];
         Un[0] = 0, Un[1] = 0;
+      }
+      if (Tv) { /* the viscous map: the wall's own condition */
+        real *Tw = Tv + 4 * n, *Uw = Uv + 2 * n;
+        if (S[7] == 1) {
+          Tw[0] = -1, Tw[1] = 0, Tw[2] = 0, Tw[3] = -1;
+          Uw[0] = 2 * S[8], Uw[1] = 2 * S[9];
+        } else {
+          for (int k = 0; k < 4; k++)
+            Tw[k] = Tn[k];
+          Uw[0] = Un[0], Uw[1] = Un[1];
+        }
+        if (body >= 0)
+          body_ghost(kin + RHOD_KIN_STRIDE * body, x - d * S[2], y - d * S[3], Tw, Uw, NULL);
       }
       if (body >= 0)
         body_ghost(kin + RHOD_KIN_STRIDE * body, x - d * S[2], y - d * S[3], Tn, Un,
@@ -166,52 +232,15 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       Jn[1] = b0 * a1 + b1 * a3;
       Jn[2] = b1 * a0 + b3 * a1;
       Jn[3] = b1 * a1 + b3 * a3;
-      if (A_[7] >= RHOD_SEG_INFLOW || B_[7] >= RHOD_SEG_INFLOW) {
-        /* a corner with an open boundary (open.h): the two mirrors composed, u' = T_b (T_a u +
-         * U_a) + U_b, each segment's own transform at the source's foot on it */
-        real Ta0, Ta1, Ta2, Ta3, Ua0, Ua1, Tb0, Tb1, Tb2, Tb3, Ub0, Ub1;
-        if (A_[7] >= RHOD_SEG_INFLOW) {
-          open_ghost(A_, openu, A_[4] * (x - A_[0]) + A_[5] * (y - A_[1]), Tn, Un);
-        } else if (A_[7] != 0) {
-          Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
-          Un[0] = 2 * A_[8], Un[1] = 2 * A_[9];
-        } else {
-          Tn[0] = a0, Tn[1] = a1, Tn[2] = a1, Tn[3] = a3;
-          Un[0] = 0, Un[1] = 0;
-        }
-        Ta0 = Tn[0], Ta1 = Tn[1], Ta2 = Tn[2], Ta3 = Tn[3], Ua0 = Un[0], Ua1 = Un[1];
-        if (B_[7] >= RHOD_SEG_INFLOW) {
-          open_ghost(B_, openu, B_[4] * (x - B_[0]) + B_[5] * (y - B_[1]), Tn, Un);
-        } else if (B_[7] != 0) {
-          Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
-          Un[0] = 2 * B_[8], Un[1] = 2 * B_[9];
-        } else {
-          Tn[0] = b0, Tn[1] = b1, Tn[2] = b1, Tn[3] = b3;
-          Un[0] = 0, Un[1] = 0;
-        }
-        Tb0 = Tn[0], Tb1 = Tn[1], Tb2 = Tn[2], Tb3 = Tn[3], Ub0 = Un[0], Ub1 = Un[1];
-        Tn[0] = Tb0 * Ta0 + Tb1 * Ta2, Tn[1] = Tb0 * Ta1 + Tb1 * Ta3;
-        Tn[2] = Tb2 * Ta0 + Tb3 * Ta2, Tn[3] = Tb2 * Ta1 + Tb3 * Ta3;
-        Un[0] = Tb0 * Ua0 + Tb1 * Ua1 + Ub0, Un[1] = Tb2 * Ua0 + Tb3 * Ua1 + Ub1;
-      } else if (A_[7] != 0 || B_[7] != 0) {
-        Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
-        /* our choice (docs/choices.md "moving walls at corners"): with T = -I the corner
-         * ghost is a no-slip mirror of the corner, whose velocity is the mean of the
-         * no-slip walls meeting there (a free-slip wall imposes none): U = 2 u_corner.
-         * Composing the two mirrors, T_b (T_a u + U_a) + U_b, would give -U_a + U_b for
-         * two no-slip walls: the lid's velocity reversed at one of a cavity's corners */
-        const real na = A_[7] != 0 ? 1 : 0, nb = B_[7] != 0 ? 1 : 0;
-        Un[0] = 2 * (na * A_[8] + nb * B_[8]) / (na + nb);
-        Un[1] = 2 * (na * A_[9] + nb * B_[9]) / (na + nb);
-      } else {
-        for (int k = 0; k < 4; k++)
-          Tn[k] = Jn[k];
-        Un[0] = 0, Un[1] = 0; /* T_b (T_a u + 0) + 0: free slip on both */
-      }
+      corner_map(A_, B_, openu, x, y, Jn, !Tv, Tn, Un);
+      if (Tv)
+        corner_map(A_, B_, openu, x, y, Jn, 1, Tv + 4 * n, Uv + 2 * n);
       const int body = (int)A_[10];
-      if (body >= 0) /* a body's concave vertex: the kinematics at the vertex, b's start */
+      if (body >= 0) { /* a body's concave vertex: the kinematics at the vertex, b's start */
         body_ghost(kin + RHOD_KIN_STRIDE * body, B_[0], B_[1], Tn, Un, A ? A + 2 * n : NULL);
-      else if (A)
+        if (Tv)
+          body_ghost(kin + RHOD_KIN_STRIDE * body, B_[0], B_[1], Tv + 4 * n, Uv + 2 * n, NULL);
+      } else if (A)
         A[2 * n] = 0, A[2 * n + 1] = 0;
       if (B)
         B[n] = body;
@@ -245,7 +274,7 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       Jn[1] = -2 * ex * ey;
       Jn[2] = Jn[1];
       Jn[3] = 1 - 2 * ey * ey;
-      if (C[4] != 0) {
+      if (C[4] != 0 && !Tv) {
         Tn[0] = -1, Tn[1] = 0, Tn[2] = 0, Tn[3] = -1;
       } else {
         /* free slip on a curved wall: no shear stress is d(u_t/r)/dr = 0, so the mirror
@@ -259,6 +288,15 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
         Tn[3] = k - (1 + k) * ey * ey;
       }
       const int body = (int)C[5];
+      if (Tv) { /* the viscous map: the circle's own condition */
+        real *Tw = Tv + 4 * n, *Uw = Uv + 2 * n;
+        for (int q = 0; q < 4; q++)
+          Tw[q] = C[4] != 0 ? (q == 0 || q == 3 ? -1 : 0) : Tn[q];
+        Uw[0] = 0, Uw[1] = 0;
+        if (body >= 0)
+          body_ghost(kin + RHOD_KIN_STRIDE * body, C[0] + C[2] * ex, C[1] + C[2] * ey, Tw, Uw,
+                     NULL);
+      }
       if (body >= 0)
         body_ghost(kin + RHOD_KIN_STRIDE * body, C[0] + C[2] * ex, C[1] + C[2] * ey, Tn, Un,
                    A ? A + 2 * n : NULL);
@@ -347,7 +385,8 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
         continue;
       }
       cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, openu, x[i], y[i],
-                            ratio * dx[i], 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL);
+                            ratio * dx[i], 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
+                            NULL);
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)n + 1);
     if (total < 0)
@@ -358,7 +397,7 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       continue; /* the arrays moved: count again */
     }
     real *gxo = p->x, *gyo = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
-    real *gU = p->gU, *gA = p->gA;
+    real *gU = p->gU, *gA = p->gA, *gTv = p->gTv, *gUv = p->gUv;
     int32_t *gsrc = p->gsrc, *gbody = p->gbody;
     RHOD_KERNEL_LOOP
     for (long i = 0; i < n; i++) {
@@ -368,7 +407,8 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       const long base = n + cnt[i];
       wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, openu, gxo[i], gyo[i],
                    ratio * gdx[i], m[i], gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base,
-                   gU + 2 * base, gA ? gA + 2 * base : NULL, gbody ? gbody + base : NULL, m + base);
+                   gU + 2 * base, gTv ? gTv + 4 * base : NULL, gTv ? gUv + 2 * base : NULL,
+                   gA ? gA + 2 * base : NULL, gbody ? gbody + base : NULL, m + base);
       for (long g = base; g < base + c; g++) {
         gdx[g] = gdx[i];
         gsrc[g] = (int32_t)i;
@@ -423,7 +463,7 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
       return -2;
     }
     real *X = p->x, *Y = p->y, *m = p->m, *gdx = p->dx, *gJ = p->gJ, *gT = p->gT, *ge = p->ge;
-    real *gU = p->gU, *gA = p->gA;
+    real *gU = p->gU, *gA = p->gA, *gTv = p->gTv, *gUv = p->gUv;
     int32_t *gsrc = p->gsrc, *gbody = p->gbody;
     RHOD_KERNEL_LOOP
     for (long k = 0; k < nsrc; k++) {
@@ -449,6 +489,10 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
             gT[4 * g] = 1, gT[4 * g + 1] = 0, gT[4 * g + 2] = 0, gT[4 * g + 3] = 1;
             ge[2 * g] = 0, ge[2 * g + 1] = 0;
             gU[2 * g] = 0, gU[2 * g + 1] = 0;
+            if (gTv) {
+              gTv[4 * g] = 1, gTv[4 * g + 1] = 0, gTv[4 * g + 2] = 0, gTv[4 * g + 3] = 1;
+              gUv[2 * g] = 0, gUv[2 * g + 1] = 0;
+            }
             if (gA)
               gA[2 * g] = 0, gA[2 * g + 1] = 0;
             if (gbody)
@@ -461,6 +505,11 @@ static long build_periodic(rhod_boundary *b, rhod_particles *p, long nw, real ma
             }
             ge[2 * g] = ge[2 * k], ge[2 * g + 1] = ge[2 * k + 1];
             gU[2 * g] = gU[2 * k], gU[2 * g + 1] = gU[2 * k + 1];
+            if (gTv) {
+              for (int q = 0; q < 4; q++)
+                gTv[4 * g + q] = gTv[4 * k + q];
+              gUv[2 * g] = gUv[2 * k], gUv[2 * g + 1] = gUv[2 * k + 1];
+            }
             if (gA)
               gA[2 * g] = gA[2 * k], gA[2 * g + 1] = gA[2 * k + 1];
             if (gbody) /* an image of a mirror: the force pass counts its original only */

@@ -196,8 +196,12 @@ int rhod_boundary_init(rhod_boundary *b, const rhod_scene *sc, const double lo[2
     b->moving |= B->motion != RHOD_MOTION_FIXED;
   }
   b->nbody = (int)sc->n_bodies;
-  for (int k = 0; k < b->nseg; k++)
+  for (int k = 0; k < b->nseg; k++) {
     b->moving |= b->seg[RHOD_SEG_STRIDE * k + 8] != 0 || b->seg[RHOD_SEG_STRIDE * k + 9] != 0;
+    b->noslip |= b->seg[RHOD_SEG_STRIDE * k + 7] == 1;
+  }
+  for (int k = 0; k < b->ncirc; k++)
+    b->noslip |= b->circ[RHOD_CIRC_STRIDE * k + 4] != 0;
   if (b->nbody > 0) {
     const size_t ss = sizeof(real) * RHOD_SEG_STRIDE * (size_t)b->nseg;
     const size_t cs = sizeof(real) * RHOD_CIRC_STRIDE * (size_t)b->ncirc;

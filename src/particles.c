@@ -100,6 +100,15 @@ real rhod_max_real(const real *v, long n) {
   return m;
 }
 
+int rhod_particles_add_noslip_fields(rhod_particles *p) {
+  int st = RHOD_OK;
+  if (!p->gTv)
+    st = rhod_particles_add_field(p, "gTv", (void **)&p->gTv, 4 * sizeof(real), 0);
+  if (st == RHOD_OK && !p->gUv)
+    st = rhod_particles_add_field(p, "gUv", (void **)&p->gUv, 2 * sizeof(real), 0);
+  return st;
+}
+
 int rhod_particles_add_body_fields(rhod_particles *p) {
   int st = RHOD_OK;
   if (!p->gA)

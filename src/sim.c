@@ -495,6 +495,8 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
     st = rhod_boundary_init(&s->bnd, sc, s->lo, s->hi);
   if (st == RHOD_OK && sc->n_bodies > 0)
     st = rhod_particles_add_body_fields(&s->p);
+  if (st == RHOD_OK && s->bnd.noslip)
+    st = rhod_particles_add_noslip_fields(&s->p);
   if (st != RHOD_OK) {
     snprintf(err, errlen, "out of memory setting up the particles");
     return st;

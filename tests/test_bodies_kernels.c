@@ -35,7 +35,8 @@ typedef struct {
   rhod_boundary b;
   rhod_bodies bb;
   rhod_cells c;
-  double *gam; /* Gamma of every fluid particle */
+  double *gam;       /* Gamma of every fluid particle */
+  int noslip_fields; /* build with gTv, gUv (a scene with a no-slip wall or body) */
 } setup;
 
 /* The lattice (i + 1/2) DX over [0, L]^2 outside the body, the body's ghosts built (at
@@ -46,6 +47,8 @@ static void make(setup *t, double tlaw, real *P, real *V) {
   sc->bodies = &t->body, sc->n_bodies = 1;
   CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&t->p, 1024), RHOD_OK);
   CU_ASSERT_EQUAL_FATAL(rhod_particles_add_body_fields(&t->p), RHOD_OK);
+  if (t->noslip_fields)
+    CU_ASSERT_EQUAL_FATAL(rhod_particles_add_noslip_fields(&t->p), RHOD_OK);
   const double lo[2] = {0, 0}, hi[2] = {L, L};
   CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&t->b, sc, lo, hi), RHOD_OK);
   char err[256];
@@ -78,6 +81,10 @@ static void make(setup *t, double tlaw, real *P, real *V) {
   rhod_to_host(p->gU, 2 * nt * sizeof(real));
   rhod_to_host(p->gA, 2 * nt * sizeof(real));
   rhod_to_host(p->gbody, nt * sizeof(int32_t));
+  if (p->gTv) {
+    rhod_to_host(p->gTv, 4 * nt * sizeof(real));
+    rhod_to_host(p->gUv, 2 * nt * sizeof(real));
+  }
   rhod_to_host(p->ux, n * sizeof(real));
   rhod_to_host(p->uy, n * sizeof(real));
   /* Gamma_i = sum_j W(r_ij, R) V_j over fluid and ghosts, V_j = m_j / rho0 (brute force) */
@@ -249,6 +256,82 @@ static void test_moving_kinematics(void) {
   CU_ASSERT(checked > 100);
   CU_ASSERT(worst_u < EPS);
   CU_ASSERT(worst_a < EPS);
+  unmake(&t);
+}
+
+/* No slip in the viscous terms alone (docs/choices.md "no slip in the viscous term only"):
+ * the moving no-slip body of test_moving_kinematics built with gTv, gUv. The viscous map
+ * (gTv, gUv) is the no-slip mirror, (u_s + u_g)/2 = u_w; the map every other term reads
+ * (gT, gU) is the free-slip mirror of a moving face, whose ghost moves with the wall along the
+ * normal, (u_s + u_g).n/2 = u_w.n, and keeps the source's tangential velocity. A circle's
+ * no-slip ghosts get the curved free-slip map in gT (u_t scaled by r_g/r_s) and -I in gTv. */
+static void test_noslip_maps(void) {
+  setup t;
+  init_body(&t, RHOD_SHAPE_RECT);
+  t.noslip_fields = 1;
+  t.body.motion = RHOD_MOTION_IMPOSED;
+  t.body.slip = RHOD_SLIP_NO;
+  char lx[] = "0.05*t^2", lt[] = "0.2*t";
+  t.body.law[0] = lx, t.body.law[2] = lt;
+  make(&t, 1.0, NULL, NULL);
+  const rhod_particles *p = &t.p;
+  CU_ASSERT_FATAL(p->gTv != NULL);
+  const double Gx = 0.4 + 0.05, Gy = 0.4, W = 0.2;
+  int checked = 0;
+  double worst_v = 0, worst_n = 0, worst_t = 0;
+  for (size_t g = p->n; g < p->n + p->ng; g++) {
+    if (p->gbody[g] != 0)
+      continue;
+    const int s = p->gsrc[g];
+    const double fx = 0.5 * (p->x[g] + p->x[s]), fy = 0.5 * (p->y[g] + p->y[s]);
+    if (fabs(rhod_wall_distance(&t.b, fx, fy)) > 1e3 * TOLX)
+      continue;
+    const double rx = fx - Gx, ry = fy - Gy;
+    const double uwx = 0.1 - W * ry, uwy = W * rx;
+    const double us = p->ux[s], vs = p->uy[s];
+    const real *Tv = p->gTv + 4 * g, *T = p->gT + 4 * g;
+    const double vgx = Tv[0] * us + Tv[1] * vs + p->gUv[2 * g];
+    const double vgy = Tv[2] * us + Tv[3] * vs + p->gUv[2 * g + 1];
+    worst_v = fmax(worst_v, hypot(0.5 * (vgx + us) - uwx, 0.5 * (vgy + vs) - uwy));
+    const double ugx = T[0] * us + T[1] * vs + p->gU[2 * g];
+    const double ugy = T[2] * us + T[3] * vs + p->gU[2 * g + 1];
+    const double d = hypot(p->x[s] - p->x[g], p->y[s] - p->y[g]);
+    const double nx = (p->x[s] - p->x[g]) / d, ny = (p->y[s] - p->y[g]) / d;
+    worst_n =
+        fmax(worst_n, fabs(0.5 * ((ugx + us) * nx + (ugy + vs) * ny) - (uwx * nx + uwy * ny)));
+    worst_t = fmax(worst_t, fabs((ugx - us) * -ny + (ugy - vs) * nx));
+    checked++;
+  }
+  printf("\n  no-slip body: %d ghosts; viscous map max |(u_s + u_g)/2 - u_w| = %.3g; free-slip "
+         "map max normal error %.3g, tangential change %.3g\n",
+         checked, worst_v, worst_n, worst_t);
+  CU_ASSERT(checked > 100);
+  CU_ASSERT(worst_v < EPS && worst_n < EPS && worst_t < EPS);
+  unmake(&t);
+  /* a circle at rest */
+  init_body(&t, RHOD_SHAPE_CIRCLE);
+  t.noslip_fields = 1;
+  t.body.slip = RHOD_SLIP_NO;
+  make(&t, 0, NULL, NULL);
+  p = &t.p;
+  checked = 0;
+  double worst = 0;
+  for (size_t g = p->n; g < p->n + p->ng; g++) {
+    const int s = p->gsrc[g];
+    const real *Tv = p->gTv + 4 * g, *T = p->gT + 4 * g;
+    const double ex = p->x[s] - 0.405, ey = p->y[s] - 0.405, rs = hypot(ex, ey);
+    const double rg = hypot(p->x[g] - 0.405, p->y[g] - 0.405), k = rg / rs;
+    const double nx = ex / rs, ny = ey / rs;
+    /* T = k (I - e e^T) - e e^T; Tv = -I; no wall part at rest */
+    worst = fmax(worst, fabs(T[0] - (k - (1 + k) * nx * nx)) + fabs(T[1] + (1 + k) * nx * ny) +
+                            fabs(T[2] + (1 + k) * nx * ny) + fabs(T[3] - (k - (1 + k) * ny * ny)));
+    worst = fmax(worst, fabs(Tv[0] + 1) + fabs(Tv[1]) + fabs(Tv[2]) + fabs(Tv[3] + 1) +
+                            fabs(p->gUv[2 * g]) + fabs(p->gUv[2 * g + 1]) + fabs(p->gU[2 * g]) +
+                            fabs(p->gU[2 * g + 1]));
+    checked++;
+  }
+  printf("  no-slip circle: %d ghosts, max map error %.3g\n", checked, worst);
+  CU_ASSERT(checked > 100 && worst < EPS);
   unmake(&t);
 }
 
@@ -431,6 +514,7 @@ int main(void) {
       {"convex corner tiled once", test_convex_corner},
       {"circle mirrors carry the area ratio", test_circle_mass},
       {"moving body kinematics", test_moving_kinematics},
+      {"no slip in the viscous map only", test_noslip_maps},
       {"buoyancy from the pressure integral", test_buoyancy},
       {"free motion in lockstep", test_free_motion},
       {"no cap on segments and mirrors", test_no_cap},

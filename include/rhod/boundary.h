@@ -39,6 +39,7 @@ typedef struct {
   int32_t *corner; /* ncorner * 2: segments meeting at a corner that needs a double mirror */
   real *circ;      /* ncirc * RHOD_CIRC_STRIDE */
   int moving;      /* some segment has a non-zero velocity, or some body moves */
+  int noslip;      /* some wall or body is no-slip (the ghosts then carry two velocity maps) */
   int periodic[2];
   double lo[2], hi[2]; /* domain box */
   int32_t *count;      /* per-particle ghost counts (scan buffer), cap + 1 */
@@ -68,6 +69,10 @@ void rhod_boundary_free(rhod_boundary *b);
  * in a corner (T = -I where either wall is no-slip, else J_b J_a) the mean of the
  * no-slip walls' 2 u_wall (docs/choices.md "moving walls at corners"); a periodic image
  * copies its source's.
+ * With gTv (rhod_particles_add_noslip_fields: a scene with a no-slip wall or body), that
+ * map goes to gTv, gUv, which the viscous terms read, and gT, gU take every wall's and
+ * body's free-slip map (T = J, or the curved mirror of a circle; a body's gU = (I - T) u_w),
+ * which the other terms read (docs/choices.md "no slip in the viscous term only").
  * A body's ghosts (docs/choices.md "bodies"): u_g = u_w + T (u_s - u_w), i.e. gU = (I - T) u_w
  * with u_w the boundary's velocity at the mirror's foot (a vertex for a double mirror);
  * when the store has them (rhod_particles_add_body_fields), gA = a_w there (0 for walls)
@@ -145,5 +150,7 @@ void rhod_ghosts_map_vector(const rhod_particles *p, real *v);
 /* (vx, vy)_g = T (vx, vy)_src + gU: a velocity (T is J for free slip and periodic images,
  * -I for no slip; gU a moving wall's part, 0 where no wall moves) */
 void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy);
+/* The same with the viscous terms' map (gTv, gUv) where the store has it, else gT, gU */
+void rhod_ghosts_map_velocity_viscous(const rhod_particles *p, real *vx, real *vy);
 
 #endif

@@ -41,15 +41,19 @@ typedef struct {
    * Jacobian J (x' = J x + c, row-major), velocity transform T, and the
    * displacement e used for the hydrostatic correction P' = P + rho g.e */
   int32_t *gsrc;
-  real *gJ, *gT;  /* 4 per particle */
-  real *gU;       /* 2 per particle: the moving wall's part of the ghost velocity,
-                     u_g = T u_src + gU (boundary.h); 0 where no wall moves */
-  real *ge;       /* 2 per particle */
-  real *gA;       /* 2 per particle: a body's boundary acceleration at the mirror's foot
-                     (the ghost pressure's g - a_w), 0 for walls; NULL without bodies */
-  int32_t *gbody; /* the body a ghost mirrors (its index); -2 for a periodic image of a
-                     fluid particle; -1 otherwise (a wall's mirror, an image of a mirror);
-                     NULL without bodies */
+  real *gJ, *gT;   /* 4 per particle */
+  real *gU;        /* 2 per particle: the moving wall's part of the ghost velocity,
+                      u_g = T u_src + gU (boundary.h); 0 where no wall moves */
+  real *ge;        /* 2 per particle */
+  real *gA;        /* 2 per particle: a body's boundary acceleration at the mirror's foot
+                      (the ghost pressure's g - a_w), 0 for walls; NULL without bodies */
+  real *gTv, *gUv; /* 4 and 2 per particle: the viscous terms' map of a ghost's velocity,
+                      u_g = Tv u_src + gUv, where a wall or body is no-slip (gT, gU are then
+                      the free-slip map the other terms read: boundary.h); NULL without a
+                      no-slip wall or body */
+  int32_t *gbody;  /* the body a ghost mirrors (its index); -2 for a periodic image of a
+                      fluid particle; -1 otherwise (a wall's mirror, an image of a mirror);
+                      NULL without bodies */
   /* scratch for reordering */
   void *scratch;
   size_t scratch_elem;
@@ -65,6 +69,8 @@ int rhod_particles_add_field(rhod_particles *p, const char *name, void **ptr, si
                              int persistent);
 /* Registers the tags phase, kind and level (zero-filled, persistent). */
 int rhod_particles_add_tags(rhod_particles *p);
+/* Registers gTv and gUv (a scene with a no-slip wall or body). */
+int rhod_particles_add_noslip_fields(rhod_particles *p);
 /* The largest of v[0, n) (0 when n is 0): a reduction on the device, e.g. the largest
  * particle size, whose radius a gather over mixed sizes scans. */
 real rhod_max_real(const real *v, long n);

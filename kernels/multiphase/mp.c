@@ -123,8 +123,10 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
     col[i] = T[RHOD_MP_TAB_COLOUR * MAXP + k];
   }
   /* ghosts: plain copies of the source's state (no hydrostatic correction), the velocity
-   * through T (free slip, no slip, periodic images) */
-  rhod_ghosts_map_velocity(p, p->ux, p->uy);
+   * through the walls' own conditions (free slip, no slip, periodic images) in every term:
+   * this scheme does not yet split no slip into its viscous term alone (docs/choices.md
+   * "no slip in the viscous term only") */
+  rhod_ghosts_map_velocity_viscous(p, p->ux, p->uy);
   rhod_ghosts_map_scalar(p, p->rho);
   rhod_ghosts_map_scalar(p, m->P);
   rhod_ghosts_map_scalar(p, m->V);

@@ -98,7 +98,11 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
     F(jM, 3);
     F(dup, 2);
   }
-  F(pk, bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS);
+  /* no slip in the viscous terms alone: their velocity and its two pack rows */
+  s->vrow = sc->rs->mu > 0 && p->gTv ? (bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS) : 0;
+  if (s->vrow)
+    F(uv, 2);
+  F(pk, (bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS) + (s->vrow ? 2 : 0));
   if (s->adlim) {
     st = st == RHOD_OK ? rhod_particles_add_field(p, "adv", (void **)&s->adv, 2 * sizeof *s->adv, 1)
                        : st;
@@ -122,10 +126,14 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
   const real c0 = s->c0, c2 = s->c0 * s->c0, rho0 = s->rho0, gx = s->gx, gy = s->gy;
   const int walls_move = s->walls_move;
   (void)c0;
+  real *uv = s->uv;
+  const real *gTv = p->gTv, *gUv = p->gUv;
   RHOD_KERNEL_LOOP
   for (long i = 0; i < n; i++) {
     P[i] = c2 * (rho[i] - rho0); /* Eq. 2 */
     V[i] = m[i] / rho[i];
+    if (uv)
+      uv[2 * i] = ux[i], uv[2 * i + 1] = uy[i];
   }
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++) {
@@ -138,6 +146,14 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
       ugx += gU[2 * g], ugy += gU[2 * g + 1];
     ux[g] = ugx;
     uy[g] = ugy;
+    if (uv) { /* the viscous terms' map (docs/choices.md "no slip in the viscous term only") */
+      const real *Tv = gTv + 4 * g;
+      real vgx = Tv[0] * ux[k] + Tv[1] * uy[k], vgy = Tv[2] * ux[k] + Tv[3] * uy[k];
+      if (walls_move)
+        vgx += gUv[2 * g], vgy += gUv[2 * g + 1];
+      uv[2 * g] = vgx;
+      uv[2 * g + 1] = vgy;
+    }
     /* Hydrostatic correction of the mirrored pressure (scheme.md, Walls). Our choice:
      * the exact weakly compressible profile of the state law (Eq. 2), along which
      * c0^2 d rho = rho g . dx, so rho_g = rho_k exp(a) with a = g . (x_g - x_k) / c0^2,
@@ -186,6 +202,10 @@ static void pack_c(rhod_sph *s, const rhod_particles *p, const rhod_cells *c) {
   if (s->dup) { /* a balanced shifting switch only */
     rhod_cells_pack(c, nt, pk + RHOD_PK_DPX * st, s->dup, 2, 0);
     rhod_cells_pack(c, nt, pk + RHOD_PK_DPY * st, s->dup, 2, 1);
+  }
+  if (s->vrow) { /* no slip in the viscous terms alone */
+    rhod_cells_pack(c, nt, pk + s->vrow * st, s->uv, 2, 0);
+    rhod_cells_pack(c, nt, pk + (s->vrow + 1) * st, s->uv, 2, 1);
   }
 }
 
@@ -880,8 +900,9 @@ typedef struct {
                 nvptx put the struct in a lane-shared frame (tests/offload_frames.sh) */
 } pass_c_consts;
 /* the consistent Laplacian; scheme.tensile_control; scheme.shifting_switch: the momentum
- * term's difference form, the continuity terms', the balanced momentum term */
-enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4, PC_SHSWC = 8, PC_SHBAL = 16 };
+ * term's difference form, the continuity terms', the balanced momentum term; the viscous
+ * terms' own velocity rows (rhod_sph.vrow) */
+enum { PC_VCONS = 1, PC_TIC = 2, PC_SHSW = 4, PC_SHSWC = 8, PC_SHBAL = 16, PC_UV = 32 };
 
 #define PC_PARAMS                                                                                  \
   rhod_grid G, const int32_t *CS, const real *x, const real *y, const real *ux, const real *uy,    \
@@ -911,6 +932,11 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   const int bal = (K.flags & PC_SHBAL) != 0;
   const real dpi = bal ? dup[2 * i] : dui, dqi = bal ? dup[2 * i + 1] : dvi;
   const real *kdpx = bal ? pk + RHOD_PK_DPX * st : kdux, *kdpy = bal ? pk + RHOD_PK_DPY * st : kduy;
+  /* the neighbours' velocity in the viscous terms: a no-slip ghost's own (rhod_sph.vrow, the
+   * rows after the others) */
+  const long vrow = bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS;
+  const int hasv = (K.flags & PC_UV) != 0;
+  const real *kvx = hasv ? pk + vrow * st : kux, *kvy = hasv ? pk + (vrow + 1) * st : kuy;
   const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];
   const real Gi0 = gu[4 * i], Gi1 = gu[4 * i + 1], Gi2 = gu[4 * i + 2], Gi3 = gu[4 * i + 3];
   /* Which sums are renormalised is known before the loop (Eq. 6: i in I and
@@ -979,10 +1005,11 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
       if (visc) {
         /* consistent: mu 2 F (n.B^.n) ((u_j - u_i)/r - n.grad u_i), see pass A; Eq. 10:
          * 2 (d + 2) mu pi_ij grad_i W_ij V_j */
+        const real vxj = kvx[k], vyj = kvy[k];
         const real fc = 2 * F * (bxx * nx * nx + 2 * bxy * nx * ny + byy * ny * ny);
-        const real pij = e10 * ((uxj - uxi) * rx + (uyj - uyi) * ry) * ir * ir;
-        RHOD_LANE(svsx) += fc * ((uxj - uxi) * ir - (Gi0 * nx + Gi1 * ny)) + pij * fx;
-        RHOD_LANE(svsy) += fc * ((uyj - uyi) * ir - (Gi2 * nx + Gi3 * ny)) + pij * fy;
+        const real pij = e10 * ((vxj - uxi) * rx + (vyj - uyi) * ry) * ir * ir;
+        RHOD_LANE(svsx) += fc * ((vxj - uxi) * ir - (Gi0 * nx + Gi1 * ny)) + pij * fx;
+        RHOD_LANE(svsy) += fc * ((vyj - uyi) * ir - (Gi2 * nx + Gi3 * ny)) + pij * fy;
       }
       if (shifting) {
         const real duj = kdux[k], dvj = kduy[k], rhoj = krho[k];
@@ -1092,7 +1119,7 @@ void rhod_sph_pass_c(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
       .flags = (s->visc_cons ? PC_VCONS : 0) | (s->tic ? PC_TIC : 0) |
                (s->shsw == RHOD_SHSW_MOMENTUM || s->shsw == RHOD_SHSW_ALL ? PC_SHSW : 0) |
                (s->shsw == RHOD_SHSW_ALL || s->shsw == RHOD_SHSW_BALANCED ? PC_SHSWC : 0) |
-               (rhod_sph_balanced(s) ? PC_SHBAL : 0),
+               (rhod_sph_balanced(s) ? PC_SHBAL : 0) | (s->vrow ? PC_UV : 0),
   };
   const int kern = s->kernel, riemann = s->riemann, recon = riemann && s->recon,
             shifting = s->shifting, visc = s->mu != 0;

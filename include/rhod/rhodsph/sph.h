@@ -69,6 +69,8 @@ typedef struct {
   int adlim;      /* scheme.damper_step_limit (and the damper on) */
   int visc_cons;  /* scheme.viscosity: consistent (and mu > 0) */
   int walls_move; /* some wall edge moves: ghost velocities add gU (rhod_sph_fill_state) */
+  int vrow;       /* with viscosity and a no-slip wall or body (the store has gTv): the pack
+                     row of uv's x (its y the next), after the others; 0 otherwise */
   int generic;    /* 1: the general copies of the gathers, never the specialised ones
                      (tests/test_kernels.c compares them) */
   real alpha_ad, sa, sb, seps, lam_lo, lam_hi, gamma_th, theta_th;
@@ -98,6 +100,9 @@ typedef struct {
                              rhod_sph_pass_jumps (pass A: within R_i; ghosts: 1) */
   real *jM;               /* there: the scatter moment M_i (xx, xy, yy), 3; 0 elsewhere */
   real *dup;              /* there: du' = M^-1 du (du elsewhere), 2 */
+  real *uv;               /* with vrow: the velocity the viscous terms see, 2 (the fluid's
+                             own; a ghost's through gTv, gUv: docs/choices.md "no slip in
+                             the viscous term only") */
   real *drho, *acc, *vel; /* time derivatives: d rho/dt, du/dt (2), dx/dt (2) */
   uint8_t *fs;            /* 1: free-surface particle (set F) */
   uint8_t *reg;           /* 0 inner (I), 1 vicinity (V), 2 free surface (F) */
