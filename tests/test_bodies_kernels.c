@@ -214,18 +214,24 @@ static void test_circle_mass(void) {
   unmake(&t);
 }
 
+/* The square body with an imposed motion, no slip, built at t = 1 (with gTv, gUv or not). */
+static void make_moving(setup *t, int noslip_fields) {
+  static char lx[] = "0.05*t^2", lt[] = "0.2*t";
+  init_body(t, RHOD_SHAPE_RECT);
+  t->noslip_fields = noslip_fields;
+  t->body.motion = RHOD_MOTION_IMPOSED;
+  t->body.slip = RHOD_SLIP_NO;
+  t->body.law[0] = lx, t->body.law[2] = lt;
+  make(t, 1.0, NULL, NULL);
+}
+
 /* An imposed motion: G at (0.05 t^2, 0), rotating at theta = 0.2 t. At t = 1 G moves at
  * (0.1, 0) with acceleration (0.1, 0), Omega = 0.2: each ghost of a no-slip body takes
  * u_g = 2 u_w - u_s with u_w = U + Omega x r at its mirror's foot, and a_w = A - Omega^2 r
  * (libmatheval's derivatives of the law). */
 static void test_moving_kinematics(void) {
   setup t;
-  init_body(&t, RHOD_SHAPE_RECT);
-  t.body.motion = RHOD_MOTION_IMPOSED;
-  t.body.slip = RHOD_SLIP_NO;
-  char lx[] = "0.05*t^2", lt[] = "0.2*t";
-  t.body.law[0] = lx, t.body.law[2] = lt;
-  make(&t, 1.0, NULL, NULL);
+  make_moving(&t, 0);
   const rhod_particles *p = &t.p;
   const rhod_body_state *B = &t.bb.b[0];
   CU_ASSERT(fabs(B->q[0] - 0.05) < 1e-14 && fabs(B->qd[0] - 0.1) < 1e-14 &&
@@ -267,13 +273,7 @@ static void test_moving_kinematics(void) {
  * no-slip ghosts get the curved free-slip map in gT (u_t scaled by r_g/r_s) and -I in gTv. */
 static void test_noslip_maps(void) {
   setup t;
-  init_body(&t, RHOD_SHAPE_RECT);
-  t.noslip_fields = 1;
-  t.body.motion = RHOD_MOTION_IMPOSED;
-  t.body.slip = RHOD_SLIP_NO;
-  char lx[] = "0.05*t^2", lt[] = "0.2*t";
-  t.body.law[0] = lx, t.body.law[2] = lt;
-  make(&t, 1.0, NULL, NULL);
+  make_moving(&t, 1);
   const rhod_particles *p = &t.p;
   CU_ASSERT_FATAL(p->gTv != NULL);
   const double Gx = 0.4 + 0.05, Gy = 0.4, W = 0.2;
