@@ -306,7 +306,9 @@ static void test_noslip_maps(void) {
          "map max normal error %.3g, tangential change %.3g\n",
          checked, worst_v, worst_n, worst_t);
   CU_ASSERT(checked > 100);
-  CU_ASSERT(worst_v < EPS && worst_n < EPS && worst_t < EPS);
+  CU_ASSERT(worst_v < EPS);
+  /* the normal is taken from the stored positions (float: 1e-5 at dx = 0.01) */
+  CU_ASSERT(worst_n < 5 * EPS && worst_t < 5 * EPS);
   unmake(&t);
   /* a circle at rest */
   init_body(&t, RHOD_SHAPE_CIRCLE);
