@@ -148,7 +148,8 @@ void rhod_ghosts_map_u8(const rhod_particles *p, uint8_t *f);
 /* v_g = J v_src for a vector stored 2 per particle (a normal, a gradient of a scalar) */
 void rhod_ghosts_map_vector(const rhod_particles *p, real *v);
 /* (vx, vy)_g = T (vx, vy)_src + gU: a velocity (T is J for free slip and periodic images,
- * -I for no slip; gU a moving wall's part, 0 where no wall moves) */
+ * -I for no slip unless the store has gTv, which then holds it; gU a moving wall's part,
+ * 0 where no wall moves) */
 void rhod_ghosts_map_velocity(const rhod_particles *p, real *vx, real *vy);
 /* The same with the viscous terms' map (gTv, gUv) where the store has it, else gT, gU */
 void rhod_ghosts_map_velocity_viscous(const rhod_particles *p, real *vx, real *vy);
