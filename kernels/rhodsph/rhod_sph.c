@@ -99,10 +99,10 @@ int rhod_sph_init(rhod_sph *s, const rhod_scene *sc, rhod_particles *p) {
     F(dup, 2);
   }
   /* no slip in the viscous terms alone: their velocity and its two pack rows */
-  s->vrow = sc->rs->mu > 0 && p->gTv ? (bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS) : 0;
+  s->vrow = sc->rs->mu > 0 && p->gTv ? RHOD_PK_UV_ROW(bal) : 0;
   if (s->vrow)
     F(uv, 2);
-  F(pk, (bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS) + (s->vrow ? 2 : 0));
+  F(pk, RHOD_PK_UV_ROW(bal) + (s->vrow ? 2 : 0));
   if (s->adlim) {
     st = st == RHOD_OK ? rhod_particles_add_field(p, "adv", (void **)&s->adv, 2 * sizeof *s->adv, 1)
                        : st;
@@ -934,7 +934,7 @@ PARTICLE_BODY void pass_c_particle(long i, PC_PARAMS, const int kern, const int 
   const real *kdpx = bal ? pk + RHOD_PK_DPX * st : kdux, *kdpy = bal ? pk + RHOD_PK_DPY * st : kduy;
   /* the neighbours' velocity in the viscous terms: a no-slip ghost's own (rhod_sph.vrow, the
    * rows after the others) */
-  const long vrow = bal ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS;
+  const long vrow = RHOD_PK_UV_ROW(bal);
   const int hasv = (K.flags & PC_UV) != 0;
   const real *kvx = hasv ? pk + vrow * st : kux, *kvy = hasv ? pk + (vrow + 1) * st : kuy;
   const real gPix = gP[2 * i], gPiy = gP[2 * i + 1];

@@ -56,6 +56,9 @@ enum {
   RHOD_PK_DPY,
   RHOD_PK_ROWS_BALANCED
 };
+/* with no slip in the viscous terms alone (rhod_sph.vrow): the row of the viscous velocity's
+ * x, its y the next, after the rows above (bal: a balanced shifting switch) */
+#define RHOD_PK_UV_ROW(bal) ((bal) ? RHOD_PK_ROWS_BALANCED : RHOD_PK_ROWS)
 
 typedef struct {
   /* parameters (from the scene) */
