@@ -986,7 +986,7 @@ static void print_bodies(const rhod_scene *sc) {
 }
 
 /* One line per open boundary: its kind, name, length, resolved normal and, for an inflow,
- * its velocity law and profile (src/scene_open.c). */
+ * its velocity law and profile, for an outflow its ambient pressure (src/scene_open.c). */
 static void print_open(const rhod_scene *sc) {
   for (unsigned i = 0; i < sc->n_open; i++) {
     const rhod_open_boundary *b = &sc->open[i];
@@ -997,6 +997,8 @@ static void print_open(const rhod_scene *sc) {
     if (in)
       printf(", velocity %s m/s (%s)", b->velocity,
              b->profile == RHOD_PROFILE_PARABOLIC ? "parabolic, its mean" : "uniform");
+    else
+      printf(", ambient pressure %g Pa", b->pressure);
     if (b->surface_set)
       printf(", surface %g m", b->surface);
     printf("\n");

@@ -84,11 +84,14 @@ int rhod_open_init(rhod_open *o, const rhod_scene *sc, const rhod_boundary *b, c
       const double level =
           g > 0 ? -(o->mx[q] * sc->gravity[0] + o->my[q] * sc->gravity[1]) / g : o->my[q];
       o->wet[q] = D->kind == RHOD_OPEN_INFLOW && (!D->surface_set || level < D->surface);
-      /* an outflow's ambient pressure: 0 without gravity, hydrostatic below its surface
-       * (paper 002 Sec. VI A's profile, linearised), none under gravity without a surface */
-      o->pinf[q] = g == 0 ? 0
+      /* an outflow's ambient pressure: open_boundaries.N.pressure (default 0) without
+       * gravity; under gravity that pressure at its surface plus the hydrostatic part below
+       * it (paper 002 Sec. VI A's profile, linearised); none under gravity without a
+       * surface (the loader allows no pressure then) */
+      o->pinf[q] = g == 0 ? D->pressure
                    : D->surface_set
-                       ? (level < D->surface ? o->rho0[k] * g * (D->surface - level) : 0)
+                       ? D->pressure +
+                             (level < D->surface ? o->rho0[k] * g * (D->surface - level) : 0)
                        : NAN;
     }
     o->nout += D->kind == RHOD_OPEN_OUTFLOW;

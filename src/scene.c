@@ -70,6 +70,7 @@ typedef struct {
   double *velocity;
   int *pressure;
   double *surface;
+  double *ambient_pressure;
   y_initial *initial;
   char *phase;
 } y_fluid;
@@ -338,6 +339,7 @@ static const cyaml_schema_field_t f_fluid[] = {
     VEC("velocity", OPT, y_fluid, velocity),
     ENUM_OPT("pressure", y_fluid, pressure, init_names),
     NUM_OPT("surface", y_fluid, surface),
+    NUM_OPT("ambient_pressure", y_fluid, ambient_pressure),
     CYAML_FIELD_MAPPING_PTR("initial", OPT, y_fluid, initial, f_initial),
     CYAML_FIELD_STRING_PTR("phase", OPT, y_fluid, phase, 1, NAME_MAX_LEN),
     CYAML_FIELD_END,
@@ -1788,6 +1790,8 @@ static int convert(lctx *c, const y_doc *d, rhod_scene *s) {
       b->surface_set = 1;
       b->surface = *y->surface;
     }
+    if (y->ambient_pressure)
+      b->ambient_pressure = *y->ambient_pressure;
     double lo[2], hi[2];
     rhod_sl_shape_bbox(&b->shape, lo, hi);
     if (y->initial) {
@@ -2205,6 +2209,8 @@ static ry_node *scene_tree(const rhod_scene *s) {
             rhod_sl_enum_name(init_names, CYAML_ARRAY_LEN(init_names), (int)s->fluid[i].pressure));
     if (s->fluid[i].surface_set) /* absent at its default, so older checkpoints resume */
       tb_num(&t, e, "surface", s->fluid[i].surface);
+    if (s->fluid[i].ambient_pressure != 0) /* likewise */
+      tb_num(&t, e, "ambient_pressure", s->fluid[i].ambient_pressure);
     if (s->mp)
       tb_word(&t, e, "phase", s->mp->phases[s->fluid[i].phase].name);
     const rhod_fluid_block *fb = &s->fluid[i];

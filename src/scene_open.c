@@ -47,6 +47,7 @@ static const cyaml_schema_field_t f_open[] = {
     CYAML_FIELD_ENUM_PTR("profile", OPT | CYAML_FLAG_STRICT, y_open, profile, profile_names,
                          CYAML_ARRAY_LEN(profile_names)),
     CYAML_FIELD_FLOAT_PTR("surface", OPT | CYAML_FLAG_STRICT, y_open, surface),
+    CYAML_FIELD_FLOAT_PTR("pressure", OPT | CYAML_FLAG_STRICT, y_open, pressure),
     CYAML_FIELD_FLOAT_PTR("dx", OPT | CYAML_FLAG_STRICT, y_open, dx),
     CYAML_FIELD_STRING_PTR("phase", OPT, y_open, phase, 1, OPEN_NAME_MAX),
     CYAML_FIELD_END,
@@ -217,6 +218,19 @@ static int load_open(lctx *c, const y_open *y, unsigned i, const rhod_ob_levels 
                           *y->surface, h0, h1);
     o->surface_set = 1;
     o->surface = *y->surface;
+  }
+  /* pressure: an outflow's ambient pressure at its surface (everywhere without gravity) */
+  if (y->pressure) {
+    snprintf(path, sizeof path, "%s.pressure", base);
+    if (in)
+      return rhod_sl_fail(c, path,
+                          "only for kind: outflow (an inflow's pressure is the fluid's, "
+                          "extrapolated)");
+    if ((s->gravity[0] != 0 || s->gravity[1] != 0) && !o->surface_set)
+      return rhod_sl_fail(c, path,
+                          "needs surface under gravity (the level where the ambient pressure "
+                          "holds; the hydrostatic part is added below it)");
+    o->pressure = *y->pressure;
   }
   o->dx = s->dx;
   if (y->dx) {
@@ -391,6 +405,8 @@ void rhod_ob_tree(rhod_sl_tb *t, ry_node *root, const rhod_scene *s, const rhod_
     }
     if (o->surface_set)
       rhod_sl_num(t, e, "surface", o->surface);
+    if (o->pressure != 0) /* absent at its default, so older checkpoints resume */
+      rhod_sl_num(t, e, "pressure", o->pressure);
     rhod_sl_num(t, e, "dx", o->dx);
     if (s->scheme == RHOD_SCHEME_MULTIPHASE)
       rhod_sl_word(t, e, "phase", lv->phases[o->phase]);

@@ -18,6 +18,7 @@ typedef struct {
   char *velocity;
   int *profile;
   double *surface;
+  double *pressure;
   double *dx;
   char *phase;
 } y_open;

@@ -134,6 +134,10 @@ check "bodies: check prints each body" -- \
   grep -q "body tri (bodies.1): free polygon, centre \[1.1, 0.333333\].*mass 30 kg/m (density 500 kg/m^3), inertia 0.416667 kg m, locked: x theta" "$T/stdout"
 check "bodies: check names the fluid left inside them" -- \
   grep -q "left out: 358 inside the body bodies.0 and others" "$T/stdout"
+expect 0 "open boundaries: rhod check" -- "$RHOD" check "$SRC/tests/scenes/good/open_channel.yaml" \
+  --set open_boundaries.1.pressure=1500
+check "open boundaries: check prints each, the outflow's pressure" -- \
+  grep -q "outflow open1 (open_boundaries.1): 0.2 m long, normal \[-1, 0\], dx 0.02 m, ambient pressure 1500 Pa" "$T/stdout"
 
 # 53.6 the command line
 expect 0 "rhod help" -- "$RHOD" help

@@ -21,9 +21,10 @@
 #endif
 
 /* A channel [0, L] x [0, 0.2] between obstacle walls, an inflow at x = 0 and an outflow at
- * x = L; `extra` goes into the fluid block, `law` is the inflow's velocity. */
+ * x = L; `extra` goes into the fluid block, `law` is the inflow's velocity, `phys` into
+ * physics and `out` into the outflow's entry. */
 static int channel(run *r, const char *tag, double L, const char *extra, const char *law,
-                   const char *phys) {
+                   const char *phys, const char *out) {
   char yaml[2048];
   snprintf(yaml, sizeof yaml,
            "time: {end: 1, output_every: 0.1}\n"
@@ -36,9 +37,9 @@ static int channel(run *r, const char *tag, double L, const char *extra, const c
            "  - rect: {min: [-0.1, 0.2], max: [%g, 0.3]}\n    fluid_inside: false\n"
            "open_boundaries:\n"
            "  - {kind: inflow, from: [0, 0], to: [0, 0.2], velocity: \"%s\"}\n"
-           "  - {kind: outflow, from: [%g, 0], to: [%g, 0.2]}\n"
+           "  - {kind: outflow, from: [%g, 0], to: [%g, 0.2]%s}\n"
            "output: {picture: false}\n",
-           phys, L, L, extra, L + 0.1, L + 0.1, law, L, L);
+           phys, L, L, extra, L + 0.1, L + 0.1, law, L, L, out);
   return run_open_in(r, "test_open", tag, yaml);
 }
 
@@ -65,7 +66,7 @@ static double pending(const rhod_open *o) {
  * its markers prescribe (paper 001 Eq. 20) less what it still carries. */
 static void test_mass_exact(void) {
   run r;
-  CU_ASSERT_FATAL(channel(&r, "mass", 0.6, "", "2*(1 - exp(-t/0.05))", ""));
+  CU_ASSERT_FATAL(channel(&r, "mass", 0.6, "", "2*(1 - exp(-t/0.05))", "", ""));
   rhod_sim *s = r.sim;
   const rhod_open *o = &s->open;
   CU_ASSERT_EQUAL(o->n, 2);
@@ -96,7 +97,7 @@ static void test_mass_exact(void) {
  * channel (their masses and the gaps between the rows agree). */
 static void test_uniform_stream(void) {
   run r;
-  CU_ASSERT_FATAL(channel(&r, "uniform", 0.6, "    velocity: [1, 0]\n", "1", ""));
+  CU_ASSERT_FATAL(channel(&r, "uniform", 0.6, "    velocity: [1, 0]\n", "1", "", ""));
   rhod_sim *s = r.sim;
   const double m0 = rhod_open_mass(&s->p);
   CU_ASSERT_FATAL(steps(s, 300));
@@ -126,8 +127,8 @@ static int stream(void *ctx, int b, int k, double t, double x, double y, double 
 
 static void test_coupling_callback(void) {
   run a, b;
-  CU_ASSERT_FATAL(channel(&a, "law", 0.6, "", "1.5", ""));
-  CU_ASSERT_FATAL(channel(&b, "callback", 0.6, "", "0", ""));
+  CU_ASSERT_FATAL(channel(&a, "law", 0.6, "", "1.5", "", ""));
+  CU_ASSERT_FATAL(channel(&b, "callback", 0.6, "", "0", "", ""));
   double U = 1.5;
   rhod_open_couple(&b.sim->open, 0, stream, &U);
   CU_ASSERT_FATAL(steps(a.sim, 60));
@@ -148,7 +149,7 @@ static void test_coupling_callback(void) {
  * steps (Eq. 26), and mass stays exact. */
 static void test_negative_imbalance(void) {
   run r;
-  CU_ASSERT_FATAL(channel(&r, "reverse", 0.6, "    velocity: [-0.5, 0]\n", "-0.5", ""));
+  CU_ASSERT_FATAL(channel(&r, "reverse", 0.6, "    velocity: [-0.5, 0]\n", "-0.5", "", ""));
   rhod_sim *s = r.sim;
   const double m0 = rhod_open_mass(&s->p);
   CU_ASSERT_FATAL(steps(s, 150));
@@ -165,7 +166,7 @@ static void test_negative_imbalance(void) {
  * mirror whose velocity is the inflow's too. */
 static void test_ghosts(void) {
   run r;
-  CU_ASSERT_FATAL(channel(&r, "ghosts", 0.6, "    velocity: [0.3, 0.1]\n", "2", ""));
+  CU_ASSERT_FATAL(channel(&r, "ghosts", 0.6, "    velocity: [0.3, 0.1]\n", "2", "", ""));
   rhod_sim *s = r.sim;
   const rhod_particles *p = &s->p;
   long nin = 0, nout = 0, ncorner = 0, bad = 0;
@@ -199,7 +200,7 @@ static void test_ghosts(void) {
  * with no inflow lets fluid out until its pressure is the ambient one. */
 static void test_outflow_relaxation(void) {
   run r;
-  CU_ASSERT_FATAL(channel(&r, "relax", 0.4, "", "0", ""));
+  CU_ASSERT_FATAL(channel(&r, "relax", 0.4, "", "0", "", ""));
   rhod_sim *s = r.sim;
   for (size_t i = 0; i < s->p.n; i++)
     s->p.rho[i] = 1010;
@@ -215,11 +216,51 @@ static void test_outflow_relaxation(void) {
   run_close(&r);
 }
 
+/* An ambient pressure (fluid.N.ambient_pressure, open_boundaries.N.pressure): a channel at
+ * rest started at its outflow's pressure (2000 Pa, rho = 1000 + 2000/c0^2 = 1005) stays
+ * there, nothing moves and the outflow takes only, in the first step, what of its boundary
+ * row's cuboids (l = dx sqrt(rho/rho0), Eq. 23) lies beyond the segment; started at
+ * 4000 Pa it lets fluid out until it is back at 2000 Pa, not at 0. */
+static void test_ambient_pressure(void) {
+  static const double start[2] = {2000, 4000};
+  for (int k = 0; k < 2; k++) {
+    run r;
+    char extra[64];
+    snprintf(extra, sizeof extra, "    ambient_pressure: %g\n", start[k]);
+    CU_ASSERT_FATAL(channel(&r, k ? "ambient_high" : "ambient", 0.4, extra, "0", "",
+                            ", pressure: 2000"));
+    rhod_sim *s = r.sim;
+    double r0 = 0;
+    for (size_t i = 0; i < s->p.n; i++) /* Eq. 2: rho = rho0 + P/c0^2 */
+      r0 = fmax(r0, fabs(s->p.rho[i] - (1000 + start[k] / 400)));
+    CU_ASSERT(r0 < 1e3 * REL * 1000);
+    CU_ASSERT_FATAL(steps(s, 1));
+    const double first = s->open.taken_out;
+    CU_ASSERT_FATAL(steps(s, k ? 1500 : 300));
+    rhod_particles_to_host(&s->p);
+    double rmax = 0, umax = 0;
+    for (size_t i = 0; i < s->p.n; i++) {
+      rmax = fmax(rmax, fabs(s->p.rho[i] - 1005));
+      umax = fmax(umax, hypot(s->p.ux[i], s->p.uy[i]));
+    }
+    if (k == 0) {
+      CU_ASSERT(rmax < 1e3 * REL * 1000);
+      CU_ASSERT(umax < 1e3 * REL);
+      CU_ASSERT(first < 1e-4 * s->open.mass0);
+      CU_ASSERT_DOUBLE_EQUAL(s->open.taken_out, first, REL * s->open.mass0);
+    } else {
+      CU_ASSERT(rmax < 0.5); /* from 5 */
+      CU_ASSERT(s->open.taken_out > 0.003 * s->open.mass0);
+    }
+    run_close(&r);
+  }
+}
+
 /* An inflow faster than one particle a step (15 m/s against dx/dt = 10 m/s): the mass waiting
  * at its markers grows until the run stops, naming the boundary; nothing is changed then. */
 static void test_overwhelmed(void) {
   run r;
-  CU_ASSERT_FATAL(channel(&r, "overwhelmed", 0.6, "", "15", ""));
+  CU_ASSERT_FATAL(channel(&r, "overwhelmed", 0.6, "", "15", "", ""));
   rhod_sim *s = r.sim;
   char err[512] = "";
   int st = RHOD_OK, k = 0;
@@ -242,6 +283,7 @@ int main(void) {
       {"a negative imbalance is carried and taken", test_negative_imbalance},
       {"ghosts: inflow velocity, outflow copies, corners", test_ghosts},
       {"an outflow relaxes the pressure to the ambient", test_outflow_relaxation},
+      {"an ambient pressure holds at the outflow's", test_ambient_pressure},
       {"an overwhelmed inflow stops the run, named", test_overwhelmed},
   };
   return RHOD_RUN_TESTS("open", cases);

@@ -120,6 +120,27 @@ static void test_round_trip(void) {
   rhod_param_list_free(&p);
   rhod_scene_free(a);
   rhod_scene_free(b);
+  /* an outflow's pressure and the fluid's ambient pressure (absent at 0, above) */
+  CU_ASSERT_PTR_NULL(strstr(want, "pressure"));
+  const char *amb[] = {"open_boundaries.1.pressure=1000", "fluid.0.ambient_pressure=-250.5"};
+  a = load_ok(CHANNEL, amb, 2);
+  if (a) {
+    CU_ASSERT_EQUAL(a->open[1].pressure, 1000);
+    CU_ASSERT_EQUAL(a->open[0].pressure, 0);
+    CU_ASSERT_EQUAL(a->fluid[0].ambient_pressure, -250.5);
+    CU_ASSERT_PTR_NOT_NULL(strstr(a->yaml, "  normal: [-1, 0]\n  pressure: 1000\n  dx: 0.02\n"));
+    CU_ASSERT_PTR_NOT_NULL(strstr(a->yaml, "  ambient_pressure: -250.5\n"));
+    FILE *g = fopen(tmp, "w");
+    CU_ASSERT_PTR_NOT_NULL_FATAL(g);
+    fputs(a->yaml, g);
+    fclose(g);
+    b = load_ok(tmp, NULL, 0);
+    remove(tmp);
+    if (b)
+      CU_ASSERT_STRING_EQUAL(a->yaml, b->yaml);
+    rhod_scene_free(b);
+  }
+  rhod_scene_free(a);
   /* none: no key */
   a = load_ok(GOOD("minimal.yaml"), NULL, 0);
   if (a) {
@@ -179,6 +200,8 @@ static void test_errors(void) {
       {"open_boundaries.0.velocity=2*x", "open_boundaries.0.velocity", "unknown variable 'x'"},
       {"open_boundaries.1.velocity=1", "open_boundaries.1.velocity", "only for kind: inflow"},
       {"open_boundaries.1.profile=parabolic", "open_boundaries.1.profile", "only for kind: inflow"},
+      {"open_boundaries.0.pressure=100", "open_boundaries.0.pressure", "only for kind: outflow"},
+      {"open_boundaries.1.pressure=1e", "open_boundaries.1.pressure", "invalid number '1e'"},
       {"open_boundaries.0.surface=0.1", "open_boundaries.0.surface",
        "no effect without physics.gravity"},
       {"open_boundaries.0.dx=0", "open_boundaries.0.dx", "must be > 0"},
@@ -235,6 +258,9 @@ static void test_errors_more(void) {
       {{"physics.gravity=[0, -9.81]", "open_boundaries.0.surface=-0.01", NULL},
        "open_boundaries.0.surface",
        "negative depth"},
+      {{"physics.gravity=[0, -9.81]", "open_boundaries.1.pressure=100", NULL},
+       "open_boundaries.1.pressure",
+       "needs surface under gravity"},
       /* crossing open_boundaries.0 away from the fluid */
       {{"domain.min=[-0.5, 0]",
         "open_boundaries.2={kind: outflow, from: [-0.1, 0.05], to: [0, "

@@ -64,6 +64,9 @@ typedef struct {
   double surface;          /* hydrostatic: the free surface's level along -g [m], i.e. x.e
                               with e = -g/|g| (for g along -y, its y); default the block's
                               highest point along -g */
+  double ambient_pressure; /* fluid.N.ambient_pressure: a uniform pressure added to the
+                              initial one [Pa], default 0 (a confined flow's reference level,
+                              as an outflow's open_boundaries.N.pressure) */
   int phase;               /* fluid.N.phase: index into mp->phases; -1 for rhodsph */
   unsigned line, col;      /* where the block starts in the scene file (for messages);
                               0, 0 when an override (--set) supplied it */
@@ -152,6 +155,9 @@ typedef struct {
   int surface_set;           /* open_boundaries.N.surface given */
   double surface;            /* the free surface's level along -g (as fluid.N.surface): only
                                 the part of the segment below it is wet */
+  double pressure;           /* outflow: the ambient pressure at the free surface's level, or
+                                everywhere without gravity [Pa], default 0; the hydrostatic
+                                part below the surface is added (src/open.c) */
   double dx;                 /* the size of the particles it inserts [m], default particles.dx */
   int phase;                 /* multiphase: the phase it inserts (index), default 0; -1 for
                                 rhodsph */

@@ -18,7 +18,7 @@ static int mp_geometry(const rhod_scene *sc, double *dx_min, double *mirror_reac
 
 /* Particle k of block b: the block's phase and flow, the hydrostatic pressure where asked
  * (rho0 g depth of the block's phase: our choice, docs/choices.md "multiphase initial
- * state"), the density of the Tait EOS (paper 000 Eq. 3) inverted, and m = rho dx^2. */
+ * state") and its ambient pressure, the density of the Tait EOS (paper 000 Eq. 3) inverted, and m = rho dx^2. */
 static void mp_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double y, double dx) {
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
@@ -33,6 +33,7 @@ static void mp_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double
     const double depth = rhod_sim_block_depth(s, b, x, y, &g);
     P += rho0 * g * depth;
   }
+  P += B->ambient_pressure; /* fluid.N.ambient_pressure (docs/choices.md "ambient pressure") */
   const double rho = rhod_mp_density(&m->prm, ph, (real)P);
   p->x[k] = (real)x;
   p->y[k] = (real)y;

@@ -55,7 +55,8 @@ static int rs_fill_level(const rhod_scene *sc, double x, double y) {
 static int rs_fill_unjittered(const rhod_scene *sc) { return sc->rs->refine_dynamic; }
 
 /* Particle k of size dx at (x, y) with the initial state of block b: the block's flow,
- * the hydrostatic pressure where asked, the density of Eq. 2 and m = rho V. */
+ * the hydrostatic pressure where asked, its ambient pressure, the density of Eq. 2 and
+ * m = rho V. */
 static void rs_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double y, double dx) {
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
@@ -73,6 +74,7 @@ static void rs_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double
   rhod_sim_initial_flow(s, b, x, y, sc->rs->rho0, &u, &v, &Pf);
   if (B->flow != RHOD_FLOW_NONE)
     P += Pf;
+  P += B->ambient_pressure; /* fluid.N.ambient_pressure (docs/choices.md "ambient pressure") */
   const double rho = sc->rs->rho0 + P / c2; /* Eq. 2 */
   p->x[k] = (real)x;
   p->y[k] = (real)y;
