@@ -88,11 +88,11 @@ int rhod_open_init(rhod_open *o, const rhod_scene *sc, const rhod_boundary *b, c
        * gravity; under gravity that pressure at its surface plus the hydrostatic part below
        * it (paper 002 Sec. VI A's profile, linearised); none under gravity without a
        * surface (the loader allows no pressure then) */
-      o->pinf[q] = g == 0 ? D->pressure
-                   : D->surface_set
-                       ? D->pressure +
-                             (level < D->surface ? o->rho0[k] * g * (D->surface - level) : 0)
-                       : NAN;
+      o->pinf[q] =
+          g == 0 ? D->pressure
+          : D->surface_set
+              ? D->pressure + (level < D->surface ? o->rho0[k] * g * (D->surface - level) : 0)
+              : NAN;
     }
     o->nout += D->kind == RHOD_OPEN_OUTFLOW;
     if (D->kind == RHOD_OPEN_INFLOW) {

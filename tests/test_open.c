@@ -227,8 +227,8 @@ static void test_ambient_pressure(void) {
     run r;
     char extra[64];
     snprintf(extra, sizeof extra, "    ambient_pressure: %g\n", start[k]);
-    CU_ASSERT_FATAL(channel(&r, k ? "ambient_high" : "ambient", 0.4, extra, "0", "",
-                            ", pressure: 2000"));
+    CU_ASSERT_FATAL(
+        channel(&r, k ? "ambient_high" : "ambient", 0.4, extra, "0", "", ", pressure: 2000"));
     rhod_sim *s = r.sim;
     double r0 = 0;
     for (size_t i = 0; i < s->p.n; i++) /* Eq. 2: rho = rho0 + P/c0^2 */
