@@ -18,8 +18,8 @@ static int mp_geometry(const rhod_scene *sc, double *dx_min, double *mirror_reac
 
 /* Particle k of block b: the block's phase and flow, the hydrostatic pressure where asked
  * (rho0 g depth of the block's phase: our choice, docs/choices.md "multiphase initial
- * state") and its ambient pressure, the density of the Tait EOS (paper 000 Eq. 3) inverted, and m =
- * rho dx^2. */
+ * state") and its ambient pressure, the density of the Tait EOS (paper 000 Eq. 3)
+ * inverted, and m = rho dx^2. */
 static void mp_initial_state(rhod_sim *s, unsigned b, size_t k, double x, double y, double dx) {
   const rhod_scene *sc = s->sc;
   const rhod_fluid_block *B = &sc->fluid[b];
