@@ -225,6 +225,23 @@ static void make_moving(setup *t, int noslip_fields) {
   make(t, 1.0, NULL, NULL);
 }
 
+/* Ghost g of make_moving's body behind a single mirror: its foot (the midpoint of source
+ * and ghost) relative to G, and the wall's velocity there (0.1 along x plus W = 0.2 about
+ * G); 0 for another ghost (another body's, or a double mirror: none on a convex body). */
+static int moving_foot(const setup *t, size_t g, double *rx, double *ry, double *uwx, double *uwy) {
+  const rhod_particles *p = &t->p;
+  if (p->gbody[g] != 0)
+    return 0;
+  const int s = p->gsrc[g];
+  const double fx = 0.5 * (p->x[g] + p->x[s]), fy = 0.5 * (p->y[g] + p->y[s]);
+  if (fabs(rhod_wall_distance(&t->b, fx, fy)) > 1e3 * TOLX)
+    return 0;
+  const double Gx = 0.4 + 0.05, Gy = 0.4, W = 0.2;
+  *rx = fx - Gx, *ry = fy - Gy;
+  *uwx = 0.1 - W * *ry, *uwy = W * *rx;
+  return 1;
+}
+
 /* An imposed motion: G at (0.05 t^2, 0), rotating at theta = 0.2 t. At t = 1 G moves at
  * (0.1, 0) with acceleration (0.1, 0), Omega = 0.2: each ghost of a no-slip body takes
  * u_g = 2 u_w - u_s with u_w = U + Omega x r at its mirror's foot, and a_w = A - Omega^2 r
@@ -237,19 +254,14 @@ static void test_moving_kinematics(void) {
   CU_ASSERT(fabs(B->q[0] - 0.05) < 1e-14 && fabs(B->qd[0] - 0.1) < 1e-14 &&
             fabs(B->qdd[0] - 0.1) < 1e-14);
   CU_ASSERT(fabs(B->q[2] - 0.2) < 1e-14 && fabs(B->qd[2] - 0.2) < 1e-14 && B->qdd[2] == 0);
-  const double Gx = 0.4 + 0.05, Gy = 0.4, W = 0.2;
+  const double W = 0.2;
   int checked = 0;
   double worst_u = 0, worst_a = 0;
   for (size_t g = p->n; g < p->n + p->ng; g++) {
-    if (p->gbody[g] != 0)
+    double rx, ry, uwx, uwy;
+    if (!moving_foot(&t, g, &rx, &ry, &uwx, &uwy))
       continue;
     const int s = p->gsrc[g];
-    /* the foot of a single mirror is the midpoint of source and ghost */
-    const double fx = 0.5 * (p->x[g] + p->x[s]), fy = 0.5 * (p->y[g] + p->y[s]);
-    if (fabs(rhod_wall_distance(&t.b, fx, fy)) > 1e3 * TOLX)
-      continue; /* a double mirror (none on a convex body) */
-    const double rx = fx - Gx, ry = fy - Gy;
-    const double uwx = 0.1 - W * ry, uwy = W * rx;
     const double awx = 0.1 - W * W * rx, awy = -W * W * ry;
     /* u_g = T u_s + gU, T = -I */
     const double ugx = -p->ux[s] + p->gU[2 * g], ugy = -p->uy[s] + p->gU[2 * g + 1];
@@ -276,18 +288,13 @@ static void test_noslip_maps(void) {
   make_moving(&t, 1);
   const rhod_particles *p = &t.p;
   CU_ASSERT_FATAL(p->gTv != NULL);
-  const double Gx = 0.4 + 0.05, Gy = 0.4, W = 0.2;
   int checked = 0;
   double worst_v = 0, worst_n = 0, worst_t = 0;
   for (size_t g = p->n; g < p->n + p->ng; g++) {
-    if (p->gbody[g] != 0)
+    double rx, ry, uwx, uwy;
+    if (!moving_foot(&t, g, &rx, &ry, &uwx, &uwy))
       continue;
     const int s = p->gsrc[g];
-    const double fx = 0.5 * (p->x[g] + p->x[s]), fy = 0.5 * (p->y[g] + p->y[s]);
-    if (fabs(rhod_wall_distance(&t.b, fx, fy)) > 1e3 * TOLX)
-      continue;
-    const double rx = fx - Gx, ry = fy - Gy;
-    const double uwx = 0.1 - W * ry, uwy = W * rx;
     const double us = p->ux[s], vs = p->uy[s];
     const real *Tv = p->gTv + 4 * g, *T = p->gT + 4 * g;
     const double vgx = Tv[0] * us + Tv[1] * vs + p->gUv[2 * g];
