@@ -332,6 +332,7 @@ static const struct {
     {"relax_where_no_relax.yaml", 6, "particles.relax_where", "needs particles.relax"},
     {"refine_region_level.yaml", 14, "refinement.regions.0.level", "whole number"},
     {"refine_region_no_shape.yaml", 13, "refinement.regions.0", "needs a shape"},
+    {"refine_region_hold_static.yaml", 16, "refinement.regions.0.hold", "needs dynamic refinement"},
     {"duplicate_key.yaml", 6, "particles.dx", "duplicate key"},
     {"syntax_unclosed.yaml", 10, "fluid.0.rect", "YAML syntax"},
     {"syntax_tab.yaml", 2, "time", "YAML syntax"},

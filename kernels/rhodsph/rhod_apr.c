@@ -63,6 +63,43 @@
       (shx) += q_.x - cx_, (shy) += q_.y - cy_;                                                    \
     }
 
+/* The size a held region asks for at (x, y): the finest among those whose signed
+ * distance from (x, y) is below margin (0: the centre inside; > 0: within margin of the
+ * shape), NONE where there is none. Signed distances: a rect's as a box's, a circle's
+ * from its centre minus the radius, a polygon's to the nearest edge, negative inside
+ * (crossing number). */
+static inline real held_dx(int nh, const real *hr, const real *hp, real x, real y, real margin) {
+  real want = NONE;
+  for (int k = 0; k < nh; k++) {
+    const real *r = hr + RHOD_HOLD_STRIDE * k;
+    real d;
+    if ((int)r[0] == RHOD_SHAPE_RECT) {
+      const real qx = fmax(r[2] - x, x - r[4]), qy = fmax(r[3] - y, y - r[5]);
+      d = qx < 0 && qy < 0 ? fmax(qx, qy) : hypot(fmax(qx, 0), fmax(qy, 0));
+    } else if ((int)r[0] == RHOD_SHAPE_CIRCLE) {
+      d = hypot(x - r[2], y - r[3]) - r[4];
+    } else {
+      const long v0 = (long)r[2], nv = (long)r[3];
+      real d2 = NONE;
+      int in = 0;
+      for (long v = 0; v < nv; v++) {
+        const real *A = hp + 2 * (v0 + v), *B = hp + 2 * (v0 + (v + 1) % nv);
+        const real ex = B[0] - A[0], ey = B[1] - A[1], wx = x - A[0], wy = y - A[1];
+        const real l2 = ex * ex + ey * ey;
+        const real u = l2 > 0 ? fmin(fmax((wx * ex + wy * ey) / l2, 0), 1) : 0;
+        const real dx_ = wx - u * ex, dy_ = wy - u * ey;
+        d2 = fmin(d2, dx_ * dx_ + dy_ * dy_);
+        if ((A[1] > y) != (B[1] > y) && x < A[0] + (y - A[1]) / (B[1] - A[1]) * ex)
+          in = !in;
+      }
+      d = in ? -sqrt(d2) : sqrt(d2);
+    }
+    if (d < margin)
+      want = fmin(want, r[1]);
+  }
+  return want;
+}
+
 int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   memset(a, 0, sizeof *a);
   a->active = sc->rs->refine_dynamic;
@@ -81,10 +118,48 @@ int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   a->ieps = (real)(1 / rhod_pattern_ratio(sc->rs->pattern));
   a->coalesce = sc->rs->refine_coalesce;
   a->dx_max = (real)sc->dx;
+  /* the held regions, as flat records on the device (apr.h) */
+  const rhod_rs_scene *rs = sc->rs;
+  for (unsigned k = 0; k < rs->n_regions; k++)
+    if (rs->regions[k].hold) {
+      a->nhold++;
+      if (rs->regions[k].shape.kind == RHOD_SHAPE_POLYGON)
+        a->nhp += rs->regions[k].shape.n_points;
+    }
+  if (a->nhold == 0 || !a->active)
+    return RHOD_OK;
+  a->hr = rhod_dev_calloc(RHOD_HOLD_STRIDE * (size_t)a->nhold, sizeof(real));
+  a->hp = rhod_dev_calloc(2 * (size_t)a->nhp + 2, sizeof(real));
+  if (!a->hr || !a->hp)
+    return RHOD_ERR_MEMORY;
+  int h = 0;
+  long v = 0;
+  for (unsigned k = 0; k < rs->n_regions; k++) {
+    const rhod_region *g = &rs->regions[k];
+    if (!g->hold)
+      continue;
+    real *r = a->hr + RHOD_HOLD_STRIDE * h++;
+    r[0] = (real)g->shape.kind;
+    r[1] = (real)(sc->dx / pow(rhod_pattern_ratio(rs->pattern), g->level));
+    if (g->shape.kind == RHOD_SHAPE_RECT) {
+      r[2] = (real)g->shape.min[0], r[3] = (real)g->shape.min[1];
+      r[4] = (real)g->shape.max[0], r[5] = (real)g->shape.max[1];
+    } else if (g->shape.kind == RHOD_SHAPE_CIRCLE) {
+      r[2] = (real)g->shape.center[0], r[3] = (real)g->shape.center[1];
+      r[4] = (real)g->shape.radius;
+    } else {
+      r[2] = (real)v, r[3] = (real)g->shape.n_points;
+      for (unsigned q = 0; q < g->shape.n_points; q++, v++)
+        a->hp[2 * v] = (real)g->shape.points[q][0], a->hp[2 * v + 1] = (real)g->shape.points[q][1];
+    }
+  }
+  rhod_to_device(a->hr, sizeof(real) * RHOD_HOLD_STRIDE * (size_t)a->nhold);
+  rhod_to_device(a->hp, sizeof(real) * (2 * (size_t)a->nhp + 2));
   return RHOD_OK;
 }
 
-void rhod_apr_free(rhod_apr *a) {
+/* the per-particle buffers (ensure reallocates them) */
+static void free_buffers(rhod_apr *a) {
   rhod_dev_free(a->mark, a->cap);
   rhod_dev_free(a->near, a->cap);
   rhod_dev_free(a->cnt, (a->cap + 1) * sizeof(int32_t));
@@ -100,10 +175,17 @@ void rhod_apr_free(rhod_apr *a) {
   a->cap = 0;
 }
 
+void rhod_apr_free(rhod_apr *a) {
+  free_buffers(a);
+  rhod_dev_free(a->hr, sizeof(real) * RHOD_HOLD_STRIDE * (size_t)a->nhold);
+  rhod_dev_free(a->hp, sizeof(real) * (2 * (size_t)a->nhp + 2));
+  a->hr = a->hp = NULL;
+}
+
 static int ensure(rhod_apr *a, size_t n) {
   if (n <= a->cap && a->mark)
     return RHOD_OK;
-  rhod_apr_free(a);
+  free_buffers(a);
   a->cap = n + n / 4 + 64;
   a->mark = rhod_dev_calloc(a->cap, 1);
   a->near = rhod_dev_calloc(a->cap, 1);
@@ -230,6 +312,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   const real crowd = a->crowd;
   const int c5 = a->field && (real)t >= a->from, dyn = a->qty == RHOD_QTY_DYNAMIC_PRESSURE;
   const real above = a->above, below = a->below;
+  const int nh = a->nhold;
+  const real *hr = a->hr, *hp = a->hp;
   /* coalescing: the largest size that may merge, the thresholds of criterion 5 with
    * the margin (HYST - 1) |threshold| (1e30 stands for none and stays far away) */
   const real dgrow = ieps * a->dx_max * (1 + RHOD_SIZE_TOL);
@@ -260,10 +344,17 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
       CRITERIA_SUMS(i, Ri, quarter, lower, dxi, crowd, same, num, den, grand, crowded);
     const real phi = num / den;
     const int in3 = c3 && (reg[i] == 2 || (reg[i] == 1 && (band >= 1 || sig[i] > sband)));
+    /* a held region (ours, refinement.regions.N.hold) asking for a finer size here */
+    const int inh = nh && held_dx(nh, hr, hp, xi, yi, 0) < dxi * (1 - RHOD_SIZE_TOL);
     const int m = can_split && (grand || crowded || same < 2 * self || in3 || (c4 && near[i]) ||
-                                (c5 && (phi > above || phi < below)));
+                                (c5 && (phi > above || phi < below)) || inh);
     mark[i] = (uint8_t)m;
-    if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i])) {
+    /* nor may a group merge within one merged size e dx_i of a region that asks for
+     * less than that size: the merged particle, at most dx_i from each member, would
+     * stand in the region or split again as soon as it drifted in */
+    const int nearh =
+        nh && held_dx(nh, hr, hp, xi, yi, eps * dxi) < eps * dxi * (1 - RHOD_SIZE_TOL);
+    if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i]) && !nearh) {
       /* Coalescing candidate: the criteria for the particle of size D = e dx_i at x_i
        * (HYST above). Criterion 3 first: no free-surface particle within HYST f e R_i,
        * looked for among the free-surface particles alone (the subset cells fsc that the

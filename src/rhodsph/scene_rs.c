@@ -41,6 +41,7 @@ static const cyaml_strval_t quantity_names[] = {
 static const cyaml_schema_field_t f_region[] = {
     RHOD_SL_SHAPE_FIELDS(y_rs_region),
     CYAML_FIELD_FLOAT("level", CYAML_FLAG_STRICT, y_rs_region, level),
+    RHOD_RS_BOOL_("hold", y_rs_region, hold),
     CYAML_FIELD_END,
 };
 static const cyaml_schema_value_t sch_region = {
@@ -258,6 +259,13 @@ int rhod_rs_load_refinement(lctx *c, const y_rs_refinement *r, rhod_scene *s) {
                           "is particles.dx), got %g",
                           rs->levels - 1, y->level);
     rs->regions[i].level = (int)y->level;
+    rs->regions[i].hold = opt_bool(y->hold, 0);
+    if (rs->regions[i].hold && !rs->refine_dynamic) {
+      snprintf(path, sizeof path, "refinement.regions.%u.hold", i);
+      return rhod_sl_fail(c, path,
+                          "needs dynamic refinement (refinement.dynamic: true): a held region "
+                          "is kept at its level by splitting during the run");
+    }
   }
   const y_rs_refine_field *f = r ? r->field : NULL;
   if (f) {
@@ -371,6 +379,8 @@ void rhod_rs_tree_refinement(rhod_sl_tb *t, ry_node *root, const rhod_rs_scene *
     ry_node *r = rhod_sl_coll(t, e, NULL, RY_MAP, 0);
     rhod_sl_shape(t, r, &rs->regions[i].shape);
     rhod_sl_num(t, r, "level", rs->regions[i].level);
+    if (rs->regions[i].hold)
+      rhod_sl_bool(t, r, "hold", 1);
   }
   rhod_sl_bool(t, m, "dynamic", rs->refine_dynamic);
   rhod_sl_bool(t, m, "free_surface", rs->refine_free_surface);

@@ -52,6 +52,7 @@ typedef struct {
   double (*polygon)[2];
   unsigned n_polygon;
   double level;
+  bool *hold;
 } y_rs_region;
 
 typedef struct {

@@ -21,6 +21,8 @@
 #include "rhod/rhodsph/scene.h"
 #include "rhod/rhodsph/sph.h"
 
+#define RHOD_HOLD_STRIDE 6
+
 typedef struct {
   int active;       /* dynamic refinement on */
   real dx_min;      /* no particle is split below this size */
@@ -36,6 +38,14 @@ typedef struct {
   real eps, ieps; /* size ratio of adjacent levels (2 or sqrt 3) and its inverse */
   int coalesce;   /* refinement.coalesce */
   real dx_max;    /* no particle grows beyond this size (particles.dx) */
+  /* the held regions (refinement.regions.N.hold, ours): a particle whose centre is in
+   * one splits down to its level during the run; none coarser is merged within one
+   * merged size of it. Records of RHOD_HOLD_STRIDE reals on the device: kind (a
+   * rhod_shape_kind), the region's size dx / e^level, then rect: min x, min y, max x,
+   * max y; circle: centre x, y, radius; polygon: first vertex and vertex count in hp */
+  int nhold;
+  real *hr, *hp; /* nhold records; the polygons' vertices (x, y), nhp of them */
+  long nhp;
   /* Own buffers, not fields of the store: they must survive the store's growth
    * between marking and splitting. */
   size_t cap;

@@ -60,10 +60,12 @@ static inline double rhod_pattern_ratio(rhod_pattern p) {
 }
 
 /* An initial refinement region (square pattern): the lattice inside it starts at
- * `level` (size particles.dx / 2^level), the finest region containing a point winning. */
+ * `level` (size particles.dx / 2^level), the finest region containing a point winning;
+ * with hold, dynamic refinement keeps it there (paper 002 Sec. VI E, strategy a). */
 typedef struct {
   rhod_shape shape;
   int level;
+  int hold; /* refinement.regions.N.hold: kept at its level during the run (ours) */
 } rhod_region;
 
 /* The field of refinement criterion 5 (paper 002 Sec. V B), Shepard-averaged. */
