@@ -37,7 +37,14 @@ static const unsigned char viridis[9][3] = {{68, 1, 84},    {71, 45, 123},  {59,
                                             {44, 114, 142}, {33, 144, 140}, {39, 173, 129},
                                             {93, 200, 99},  {170, 220, 50}, {253, 231, 37}};
 
-static void colour_at(double t, unsigned char rgb[3]) {
+/* A diverging map for signed fields (the vorticity), after Moreland's cool-warm: blue through
+ * grey-white (0) to red, 9 evenly spaced stops. */
+static const unsigned char coolwarm[9][3] = {{59, 76, 192},   {98, 130, 234},  {141, 176, 254},
+                                             {184, 208, 249}, {221, 221, 221}, {245, 196, 173},
+                                             {244, 154, 123}, {222, 96, 77},   {180, 4, 38}};
+
+static void colour_at(double t, unsigned char rgb[3], int diverging) {
+  const unsigned char(*map)[3] = diverging ? coolwarm : viridis;
   if (!(t > 0))
     t = 0; /* also NaN */
   if (t > 1)
@@ -48,7 +55,7 @@ static void colour_at(double t, unsigned char rgb[3]) {
     k = 7;
   double f = s - k;
   for (int c = 0; c < 3; c++)
-    rgb[c] = (unsigned char)lround(viridis[k][c] + f * (viridis[k + 1][c] - viridis[k][c]));
+    rgb[c] = (unsigned char)lround(map[k][c] + f * (map[k + 1][c] - map[k][c]));
 }
 
 /* ------------------------------------------------------------ 5x7 font */
@@ -97,6 +104,7 @@ static const glyph font[] = {
     {'m', {0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11}},
     {'x', {0x00, 0x00, 0x11, 0x0A, 0x04, 0x0A, 0x11}},
     {'y', {0x00, 0x00, 0x11, 0x11, 0x0F, 0x01, 0x0E}},
+    {'v', {0x00, 0x00, 0x11, 0x11, 0x11, 0x0A, 0x04}},
     {'P', {0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10}},
     {'[', {0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E}},
     {']', {0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E}},
@@ -163,6 +171,8 @@ static const char *field_label(rhod_field f) {
     return "free surface [1]";
   case RHOD_FIELD_PHASE:
     return "phase [index]";
+  case RHOD_FIELD_VORTICITY:
+    return "vorticity [1/s]";
   }
   return "";
 }
@@ -181,6 +191,8 @@ static double field_value(const rhod_snapshot_view *v, rhod_field f, size_t i) {
     return v->fs ? (double)v->fs[i] : 0.0;
   case RHOD_FIELD_PHASE:
     return v->phase ? (double)v->phase[i] : 0.0;
+  case RHOD_FIELD_VORTICITY:
+    return (double)v->vort[i];
   }
   return 0.0;
 }
@@ -199,6 +211,8 @@ static int field_present(const rhod_snapshot_view *v, rhod_field f) {
   case RHOD_FIELD_FREE_SURFACE:
   case RHOD_FIELD_PHASE: /* NULL: one phase, every particle 0 */
     return 1;
+  case RHOD_FIELD_VORTICITY:
+    return v->vort != NULL;
   }
   return 0;
 }
@@ -264,6 +278,10 @@ int rhod_picture_field_range(const rhod_snapshot_view *v, rhod_field f, double r
     if (!any || x > range[1])
       range[1] = x;
     any = 1;
+  }
+  if (any && f == RHOD_FIELD_VORTICITY) { /* symmetric, zero in the middle of the map */
+    const double m = fmax(fabs(range[0]), fabs(range[1]));
+    range[0] = -m, range[1] = m;
   }
   return any ? 0 : -1;
 }
@@ -647,7 +665,7 @@ static int draw_panel(canvas *c, long y_off, const layout *L, unsigned width,
     if (!isfinite(val))
       memcpy(rgb, grey, 3);
     else
-      colour_at(scale_at(field, val, vmin, vmax), rgb);
+      colour_at(scale_at(field, val, vmin, vmax), rgb, field == RHOD_FIELD_VORTICITY);
     disc(&f, fh, cx, cy, r, rgb);
   }
   draw_walls(&f, width, fh, lo, hi, walls, n_walls);
@@ -663,7 +681,8 @@ static int draw_panel(canvas *c, long y_off, const layout *L, unsigned width,
   long bx0 = x0, bx1 = x0 + (long)width;
   for (long i = bx0; i < bx1; i++) {
     unsigned char rgb[3];
-    colour_at(bx1 - bx0 > 1 ? (double)(i - bx0) / (double)(bx1 - bx0 - 1) : 0.0, rgb);
+    colour_at(bx1 - bx0 > 1 ? (double)(i - bx0) / (double)(bx1 - bx0 - 1) : 0.0, rgb,
+              field == RHOD_FIELD_VORTICITY);
     for (long j = by; j < by + m->bar_h; j++)
       put(c, i, j, rgb);
   }
@@ -716,7 +735,7 @@ int rhod_write_picture(const char *path, const rhod_snapshot_view *v, rhod_field
                path, width, lo[0], hi[0], lo[1], hi[1], MAX_SIDE);
     return RHOD_ERR_SCENE;
   }
-  if ((int)field < RHOD_FIELD_PRESSURE || (int)field > RHOD_FIELD_PHASE) {
+  if ((int)field < RHOD_FIELD_PRESSURE || (int)field > RHOD_FIELD_VORTICITY) {
     if (err && errlen)
       snprintf(err, errlen, "%s: cannot draw: unknown field %d", path, field);
     return RHOD_ERR_SCENE;

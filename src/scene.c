@@ -235,6 +235,7 @@ static const cyaml_strval_t field_names[] = {
     {"pressure", RHOD_FIELD_PRESSURE},         {"velocity", RHOD_FIELD_VELOCITY},
     {"density", RHOD_FIELD_DENSITY},           {"size", RHOD_FIELD_SIZE},
     {"free_surface", RHOD_FIELD_FREE_SURFACE}, {"phase", RHOD_FIELD_PHASE},
+    {"vorticity", RHOD_FIELD_VORTICITY},
 };
 static const char *const probe_kind_names[] = {
     "pressure", "kinetic_energy",   "potential_energy", "front",         "mass",

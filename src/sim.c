@@ -3,6 +3,7 @@
 #include "rhod/sim.h"
 #include "rhod/kernel.h"
 #include "rhod/shepard.h"
+#include "rhod/vorticity.h"
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -388,6 +389,7 @@ static int engine_probe(rhod_probe_kind kind) {
 static const rhod_output_field engine_outputs[] = {
     {"level", "Level", "1"},
     {"kind", "Kind", "1"},
+    {"vort", "Vorticities", "1/s"}, /* computed at output (vorticity.h) */
     {NULL, NULL, NULL},
 };
 
@@ -538,6 +540,15 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
                sc->path, i, sc->probes[i].name, s->ops->name);
       return RHOD_ERR_SCENE;
     }
+  /* the vorticity, where the picture or output.fields asks for it: a store field the
+   * output fills (rhod_sim_fetch) */
+  int vort = sc->picture_enabled && sc->picture_field == RHOD_FIELD_VORTICITY;
+  for (unsigned i = 0; i < sc->n_output_fields; i++)
+    vort |= strcmp(sc->output_fields[i], "vort") == 0;
+  if (vort && rhod_particles_add_field(p, "vort", (void **)&s->vort, sizeof(real), 0) != RHOD_OK) {
+    snprintf(err, errlen, "out of memory for the vorticity");
+    return RHOD_ERR_MEMORY;
+  }
   /* the fields output.fields names must be the run's */
   st = check_output_fields(s, err, errlen);
   if (st != RHOD_OK)
@@ -947,7 +958,7 @@ int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
    * which needs the ghosts and cells of the current positions. After a step they are
    * built again here, unsorted, and marked stale again, so that the next step sorts and
    * builds them as it would have: the run goes on bit for bit as without the fields. */
-  int refresh = 0;
+  int refresh = s->vort && !s->neighbours_fresh; /* the vorticity's gather too */
   for (unsigned i = 0; i < sc->n_output_fields && !s->neighbours_fresh; i++) {
     const rhod_output_field *d;
     int scheme = 0;
@@ -960,6 +971,11 @@ int rhod_sim_fetch(rhod_sim *s, rhod_snapshot_view *v) {
       return st;
   }
   s->ops->output(s, v); /* the scheme's fields (pressure, free surface ...) */
+  if (s->vort) {
+    rhod_vorticity(&s->cells, p, sc->kernel, (real)sc->radius_ratio, *s->V, s->vort);
+    rhod_to_host(s->vort, p->n * sizeof(real));
+    v->vort = s->vort;
+  }
   if (refresh)
     s->neighbours_fresh = 0;
   const size_t n = p->n;

@@ -35,6 +35,7 @@ typedef struct {
   const uint64_t *id;   /* persistent particle id */
   const uint8_t *fs;    /* free-surface flag (1: in F), may be NULL */
   const uint8_t *phase; /* phase index (the scene's phases, in order), may be NULL */
+  const real *vort;     /* vorticity [1/s] (vorticity.h), may be NULL */
   unsigned nextra;      /* the extra datasets, in this order */
   rhod_snapshot_extra extra[RHOD_MAX_EXTRA_FIELDS];
   /* the bodies (scene's bodies, in order) where they stand at this time, may be none:

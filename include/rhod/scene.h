@@ -200,7 +200,8 @@ typedef enum {
   RHOD_FIELD_DENSITY,
   RHOD_FIELD_SIZE,
   RHOD_FIELD_FREE_SURFACE,
-  RHOD_FIELD_PHASE /* the phase index (multiphase scheme) */
+  RHOD_FIELD_PHASE,    /* the phase index (multiphase scheme) */
+  RHOD_FIELD_VORTICITY /* du_y/dx - du_x/dy (vorticity.h) */
 } rhod_field;
 
 typedef struct {

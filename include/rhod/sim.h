@@ -47,6 +47,8 @@ typedef struct rhod_sim {
   double body_mu; /* the dynamic viscosity of the bodies' force (the scheme's; 0 inviscid) */
   unsigned *outline_start; /* the bodies' outlines of the last rhod_sim_fetch */
   double *outline_xy;
+  real *vort; /* the vorticity of the last rhod_sim_fetch (a store field, "vort"), where the
+                 picture or output.fields asks for it; else NULL */
   rhod_cells cells;
   rhod_rk rk;          /* made with the scene's time.integrator; the scheme adds its variables */
   real **P, **V;       /* the scheme's pressure and volume over fluid and ghosts after
