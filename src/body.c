@@ -224,6 +224,18 @@ void rhod_bodies_begin(rhod_bodies *bb) {
   }
 }
 
+void rhod_bodies_relaxation(rhod_bodies *bb, double rho0) {
+  for (int k = 0; k < bb->n; k++) {
+    rhod_body_state *B = &bb->b[k];
+    const rhod_body *D = B->desc;
+    if (D->motion != RHOD_MOTION_FREE)
+      continue;
+    const double ma = D->added_mass >= 0 ? D->added_mass : rho0 * B->area;
+    B->ma[0] = B->ma[1] = ma;
+    B->ma[2] = ma * D->inertia / D->mass;
+  }
+}
+
 void rhod_bodies_stage(rhod_bodies *bb, const rhod_rk_table *tab, int s, double t, double dt,
                        const double gravity[2]) {
   const int last = s == tab->stages - 1;
@@ -235,8 +247,12 @@ void rhod_bodies_stage(rhod_bodies *bb, const rhod_rk_table *tab, int s, double 
       continue;
     /* 2D rigid-body dynamics: M dU/dt = F + M g, I dOmega/dt = M_z (about the centre of
      * mass G); dq/dt = (U, Omega) */
-    double a[RHOD_NDOF] = {B->F[0] / D->mass + gravity[0], B->F[1] / D->mass + gravity[1],
-                           B->F[2] / D->inertia};
+    const double M[RHOD_NDOF] = {D->mass, D->mass, D->inertia};
+    const double f[RHOD_NDOF] = {B->F[0] + D->mass * gravity[0], B->F[1] + D->mass * gravity[1],
+                                 B->F[2]};
+    double a[RHOD_NDOF];
+    for (int d = 0; d < RHOD_NDOF; d++) /* the relaxation (body.h) */
+      a[d] = (f[d] + B->ma[d] * B->qdd[d]) / (M[d] + B->ma[d]);
     for (int d = 0; d < RHOD_NDOF; d++) {
       if (D->lock[d]) {
         a[d] = 0;

@@ -974,7 +974,12 @@ static void print_bodies(const rhod_scene *sc) {
       printf(", mass %g kg/m", b->mass);
       if (b->density > 0)
         printf(" (density %g kg/m^3)", b->density);
-      printf(", inertia %g kg m, locked:", b->inertia);
+      printf(", inertia %g kg m", b->inertia);
+      if (b->added_mass >= 0)
+        printf(", added mass %g kg/m", b->added_mass);
+      else
+        printf(", added mass rho0 x area");
+      printf(", locked:");
       int any = 0;
       for (int k = 0; k < RHOD_NDOF; k++)
         if (b->lock[k])

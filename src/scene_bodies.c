@@ -61,6 +61,7 @@ static const cyaml_schema_field_t f_body[] = {
     NUM_OPT("mass", y_body, mass),
     NUM_OPT("density", y_body, density),
     NUM_OPT("inertia", y_body, inertia),
+    NUM_OPT("added_mass", y_body, added_mass),
     CYAML_FIELD_SEQUENCE_COUNT("lock", OPT | CYAML_FLAG_FLOW, y_body, lock, n_lock, &sch_dof, 0,
                                RHOD_NDOF),
     VEC_OPT("velocity", y_body, velocity),
@@ -489,8 +490,13 @@ static int check_only_for(lctx *c, const char *base, const y_body *y, rhod_motio
   const struct {
     const void *given;
     const char *key;
-  } fr[] = {{y->mass, "mass"}, {y->density, "density"},   {y->inertia, "inertia"},
-            {y->lock, "lock"}, {y->velocity, "velocity"}, {y->omega, "omega"}};
+  } fr[] = {{y->mass, "mass"},
+            {y->density, "density"},
+            {y->inertia, "inertia"},
+            {y->lock, "lock"},
+            {y->velocity, "velocity"},
+            {y->omega, "omega"},
+            {y->added_mass, "added_mass"}};
   for (size_t k = 0; k < sizeof fr / sizeof fr[0] && m != RHOD_MOTION_FREE; k++)
     if (fr[k].given) {
       snprintf(path, sizeof path, "%s.%s", base, fr[k].key);
@@ -546,6 +552,13 @@ static int load_free(lctx *c, const char *base, const y_body *y, rhod_body *b) {
       return rhod_sl_fail_oom(c);
     b->inertia = polygon_polar_moment((const double(*)[2])p, n, b->center) * b->mass / area;
     free(p);
+  }
+  b->added_mass = -1; /* rho0 x area, resolved by the run */
+  if (y->added_mass) {
+    snprintf(path, sizeof path, "%s.added_mass", base);
+    if (!(*y->added_mass >= 0))
+      return rhod_sl_fail(c, path, "must be >= 0 (kg/m; 0: no relaxation), got %g", *y->added_mass);
+    b->added_mass = *y->added_mass;
   }
   if (!(b->inertia > 0 && isfinite(b->inertia) && isfinite(b->mass))) {
     snprintf(path, sizeof path, "%s", base);
@@ -648,6 +661,8 @@ void rhod_bd_tree(rhod_sl_tb *t, ry_node *root, const rhod_scene *s) {
     if (b->density > 0) /* with the mass it gives, so that it reads back the same */
       rhod_sl_num(t, e, "density", b->density);
     rhod_sl_num(t, e, "inertia", b->inertia);
+    if (b->added_mass >= 0)
+      rhod_sl_num(t, e, "added_mass", b->added_mass);
     ry_node *lock = rhod_sl_coll(t, e, "lock", RY_SEQ, 1);
     for (int k = 0; k < RHOD_NDOF; k++)
       if (b->lock[k])

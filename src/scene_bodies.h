@@ -27,7 +27,7 @@ typedef struct {
   int *motion;
   double *center;
   y_body_law *law;
-  double *mass, *density, *inertia;
+  double *mass, *density, *inertia, *added_mass;
   int *lock;
   unsigned n_lock;
   double *velocity, *omega;

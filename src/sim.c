@@ -526,6 +526,11 @@ int rhod_sim_init(rhod_sim *s, const rhod_scene *sc, char *err, size_t errlen) {
   st = s->ops->init(s, err, errlen);
   if (st != RHOD_OK)
     return st;
+  /* the free bodies' added-mass estimates, with the scheme's densest fluid */
+  double rho_max = 0;
+  for (int k = 0; k < RHOD_SIM_PHASES; k++)
+    rho_max = fmax(rho_max, s->rho0[k]);
+  rhod_bodies_relaxation(&s->bodies, rho_max);
   /* the open boundaries' markers (their segments are in the boundary already) */
   st = rhod_open_init(&s->open, sc, &s->bnd, s->rho0, s->c0, err, errlen);
   if (st != RHOD_OK) {

@@ -421,6 +421,89 @@ static void test_free_motion(void) {
   free(sc);
 }
 
+/* The added-mass relaxation (rhod_bodies_stage, body.h) against a model fluid that answers
+ * the acceleration its ghosts took with -m_A a' (the added mass of potential flow): a body
+ * ten times lighter than m_A, explicit (m_a = 0), sees its acceleration's error grow tenfold
+ * each stage; with m_a = m_A it has the coupled a = (F_0 + M g)/(M + m_A) from the first
+ * stage on, and with m_a = m_A / 2 it gets there geometrically, by 5/6 a stage. Under a force that does not
+ * answer (m_A = 0) the relaxed acceleration converges to F/M + g by m_a/(M + m_a) a stage. */
+static void test_added_mass_relaxation(void) {
+  rhod_scene *sc = unit_scene(DX);
+  rhod_body B;
+  memset(&B, 0, sizeof B);
+  B.name = "f";
+  B.shape.kind = RHOD_SHAPE_CIRCLE;
+  B.shape.center[0] = B.shape.center[1] = 0.4;
+  B.shape.radius = 0.1;
+  B.center[0] = B.center[1] = 0.4;
+  B.motion = RHOD_MOTION_FREE;
+  const double area = RHOD_PI * 0.01, mA = RHO * area; /* the circle's added mass */
+  B.mass = 0.1 * mA, B.inertia = B.mass * 0.005;
+  B.lock[0] = B.lock[2] = 1;
+  sc->bodies = &B, sc->n_bodies = 1;
+  const double g[2] = {0, -9.81}, F0 = RHO * 9.81 * area; /* the buoyancy */
+  const double coupled = (F0 - B.mass * 9.81) / (B.mass + mA);
+  const rhod_rk_table *tab = rhod_rk_table_of(RHOD_INTEGRATOR_RK4);
+  const double relax[4] = {0, 1, 0.5, -1}; /* m_a / m_A; -1: the default, rho0 x area */
+  for (int c = 0; c < 4; c++) {
+    B.added_mass = relax[c] < 0 ? -1 : relax[c] * mA;
+    rhod_boundary b;
+    rhod_bodies bb;
+    char err[128];
+    const double lo[2] = {0, 0}, hi[2] = {1, 1};
+    CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&b, sc, lo, hi), RHOD_OK);
+    CU_ASSERT_EQUAL_FATAL(rhod_bodies_init(&bb, sc, &b, 0, 0.5 * DX, err, sizeof err), RHOD_OK);
+    rhod_bodies_relaxation(&bb, RHO);
+    CU_ASSERT(fabs(bb.b[0].ma[1] - (relax[c] < 0 ? mA : relax[c] * mA)) < 1e-12 * mA);
+    double err1 = 0, err8 = 0;
+    for (int step = 0; step < 2; step++) {
+      rhod_bodies_begin(&bb);
+      for (int s = 0; s < tab->stages; s++) {
+        bb.b[0].F[1] = F0 - mA * bb.b[0].qdd[1]; /* the model fluid */
+        bb.b[0].F[0] = bb.b[0].F[2] = 0;
+        rhod_bodies_stage(&bb, tab, s, step * 1e-4, 1e-4, g);
+        const double e = fabs(bb.b[0].qdd[1] / coupled - 1);
+        if (step == 0 && s == 0)
+          err1 = e;
+        if (step == 1 && s == 3)
+          err8 = e;
+      }
+    }
+    printf("\n  m_a/m_A = %g: |a/a_coupled - 1| %.3g after 1 stage, %.3g after 8", relax[c], err1,
+           err8);
+    if (relax[c] == 0) {
+      CU_ASSERT(err8 > 1e6); /* -m_A/M = -10 a stage */
+    } else if (relax[c] == 0.5) {
+      /* |m_a - m_A|/(M + m_a) = 5/6 a stage, exactly */
+      CU_ASSERT(fabs(err1 - 5.0 / 6) < 1e-9 && fabs(err8 - pow(5.0 / 6, 8)) < 1e-9);
+    } else {
+      CU_ASSERT(err1 < 1e-12 && err8 < 1e-12);
+    }
+    rhod_bodies_free(&bb);
+    rhod_boundary_free(&b);
+  }
+  /* a force that does not answer: F/M + g, approached by m_a/(M + m_a) = 0.91 a stage */
+  B.added_mass = -1;
+  rhod_boundary b;
+  rhod_bodies bb;
+  char err[128];
+  const double lo[2] = {0, 0}, hi[2] = {1, 1};
+  CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&b, sc, lo, hi), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_bodies_init(&bb, sc, &b, 0, 0.5 * DX, err, sizeof err), RHOD_OK);
+  rhod_bodies_relaxation(&bb, RHO);
+  double e = 0;
+  for (int s = 0; s < 200; s++) {
+    bb.b[0].F[1] = F0;
+    rhod_bodies_stage(&bb, tab, s % 4, 0, 1e-6, g);
+    e = fabs(bb.b[0].qdd[1] / (F0 / B.mass - 9.81) - 1);
+  }
+  printf("\n  a force that does not answer: |a/(F/M + g) - 1| %.3g after 200 stages ", e);
+  CU_ASSERT(e < 1e-7 && e > 0);
+  rhod_bodies_free(&bb);
+  rhod_boundary_free(&b);
+  free(sc);
+}
+
 /* No silent cap (bodies.md's defects 3): a container whose bottom is 36 collinear segments
  * gives the particle in its far corner, between segments 35 and 36, its double mirror (the
  * corner list once looked at the first 32 segments only), and a particle may have more
@@ -526,6 +609,7 @@ int main(void) {
       {"no slip in the viscous map only", test_noslip_maps},
       {"buoyancy from the pressure integral", test_buoyancy},
       {"free motion in lockstep", test_free_motion},
+      {"added-mass relaxation: a light body coupled stably", test_added_mass_relaxation},
       {"no cap on segments and mirrors", test_no_cap},
       {"wall guard against a moving body", test_guard_moving},
   };

@@ -374,6 +374,8 @@ static const struct {
     {"body_crosses_wall.yaml", 17, "bodies.0", "crosses the boundary of walls.0"},
     {"body_duplicate_name.yaml", 19, "bodies.1", "the name 'body1' is also bodies.0's"},
     {"body_free_no_mass.yaml", 17, "bodies.0.mass", "missing required key (or density"},
+    {"body_added_mass_negative.yaml", 20, "bodies.0.added_mass", "must be >= 0"},
+    {"body_added_mass_fixed.yaml", 18, "bodies.0.added_mass", "only for motion: free"},
     {"body_in_obstacle.yaml", 19, "bodies.0", "overlaps the obstacle walls.1 at t = 0"},
     {"body_inside_body.yaml", 18, "bodies.1", "overlaps bodies.0 at t = 0 (one lies inside"},
     {"body_law_not_finite.yaml", 20, "bodies.0.law.theta",

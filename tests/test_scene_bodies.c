@@ -76,6 +76,8 @@ static void check_resolved(const rhod_scene *s) {
   REL(b[3].velocity[0], 0.1);
   CU_ASSERT_EQUAL(b[3].velocity[1], 0);
   REL(b[3].omega, 1);
+  REL(b[3].added_mass, 25);
+  CU_ASSERT(b[0].added_mass < 0); /* not given: rho0 x area, resolved by the run */
 
   CU_ASSERT_STRING_EQUAL(b[4].name, "body4");
   CU_ASSERT_EQUAL(b[4].motion, RHOD_MOTION_FIXED);
@@ -138,6 +140,7 @@ static void test_round_trip(void) {
       CU_ASSERT_EQUAL(x->mass, y->mass);
       CU_ASSERT_EQUAL(x->density, y->density);
       CU_ASSERT_EQUAL(x->inertia, y->inertia);
+      CU_ASSERT_EQUAL(x->added_mass, y->added_mass);
       CU_ASSERT_EQUAL(x->center[0], y->center[0]);
       CU_ASSERT_EQUAL(x->center[1], y->center[1]);
       for (int k = 0; k < RHOD_NDOF; k++) {

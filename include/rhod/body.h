@@ -34,8 +34,10 @@ typedef struct {
   /* state: q = (d_x, d_y, theta), qd its rate; qdd the acceleration the ghost pressure uses */
   double q[RHOD_NDOF], qd[RHOD_NDOF], qdd[RHOD_NDOF];
   double q0[RHOD_NDOF], qd0[RHOD_NDOF], kq[RHOD_NDOF], kqd[RHOD_NDOF]; /* RK bookkeeping */
-  double F[3]; /* the fluid's force (Fx, Fy) and moment about G, last measured */
-  double area; /* the shape's */
+  double F[3];          /* the fluid's force (Fx, Fy) and moment about G, last measured */
+  double area;          /* the shape's */
+  double ma[RHOD_NDOF]; /* free: the added-mass estimate of the relaxation (x, y [kg/m];
+                           theta [kg m]), rhod_bodies_relaxation */
 } rhod_body_state;
 
 typedef struct {
@@ -65,6 +67,11 @@ void rhod_bodies_free(rhod_bodies *bb);
 /* Moves every body's boundary in b to its state (q, qd, qdd) and copies it to the device. */
 void rhod_bodies_place(const rhod_bodies *bb, rhod_boundary *b);
 
+/* The free bodies' added-mass estimates m_a (bodies.N.added_mass, else rho0 x the shape's
+ * area; rho0 the fluid's, the densest phase's) for x and y, and m_a I/M (the body's radius
+ * of gyration) for theta: rhod_bodies_stage's relaxation. */
+void rhod_bodies_relaxation(rhod_bodies *bb, double rho0);
+
 /* Imposed bodies: q, qd, qdd from the law at time t (others unchanged). */
 void rhod_bodies_impose(rhod_bodies *bb, double t);
 
@@ -72,7 +79,13 @@ void rhod_bodies_impose(rhod_bodies *bb, double t);
  * stage table, integrator.h): begin before stage 0; after the forces of stage s are known
  * (rhod_bodies_forces), stage sets the state for stage s + 1 at time t + c[s] dt, or the
  * final one. Imposed bodies follow their law at the stage's time. Locked degrees of
- * freedom keep their value and rate exactly. gravity: the scene's. */
+ * freedom keep their value and rate exactly. gravity: the scene's. The stage's
+ * acceleration is relaxed with the added-mass estimate m_a (ours, docs/choices.md "bodies:
+ * added-mass relaxation"): a = (F + M g + m_a a') / (M + m_a), a' the acceleration the
+ * ghosts' pressure took (the stage before's). The fluid answers a' with about -m_A a'
+ * (m_A the true added mass), so a repeats a' when a = (F_0 + M g)/(M + m_A), the coupled
+ * solution, and an error in a' comes back times (m_a - m_A)/(M + m_a) instead of the
+ * explicit coupling's -m_A/M, which grows for bodies lighter than m_A. */
 void rhod_bodies_begin(rhod_bodies *bb);
 void rhod_bodies_stage(rhod_bodies *bb, const rhod_rk_table *tab, int s, double t, double dt,
                        const double gravity[2]);

@@ -121,6 +121,9 @@ typedef struct {
   double density;          /* free: bodies.N.density [kg/m^3] as given, 0 when mass was */
   double inertia;          /* free: moment of inertia about G per unit depth [kg m]
                               (bodies.N.inertia; default: the shape's, uniform density) */
+  double added_mass;       /* free: bodies.N.added_mass [kg/m], the estimate that stabilises
+                              the coupling (body.h); < 0 when not given: rho0 x area, resolved
+                              by the run (rhod_bodies_relaxation) */
   int lock[RHOD_NDOF];     /* free: bodies.N.lock, 1 where that DOF is held */
   double velocity[2];      /* free: initial velocity of G [m/s], default [0, 0] */
   double omega;            /* free: initial angular velocity [1/s], default 0 */
