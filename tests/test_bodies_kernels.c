@@ -425,8 +425,9 @@ static void test_free_motion(void) {
  * the acceleration its ghosts took with -m_A a' (the added mass of potential flow): a body
  * ten times lighter than m_A, explicit (m_a = 0), sees its acceleration's error grow tenfold
  * each stage; with m_a = m_A it has the coupled a = (F_0 + M g)/(M + m_A) from the first
- * stage on, and with m_a = m_A / 2 it gets there geometrically, by 5/6 a stage. Under a force that does not
- * answer (m_A = 0) the relaxed acceleration converges to F/M + g by m_a/(M + m_a) a stage. */
+ * stage on, and with m_a = m_A / 2 it gets there geometrically, by 5/6 a stage. Under a force that
+ * does not answer (m_A = 0) the relaxed acceleration converges to F/M + g by m_a/(M + m_a) a stage.
+ */
 static void test_added_mass_relaxation(void) {
   rhod_scene *sc = unit_scene(DX);
   rhod_body B;
