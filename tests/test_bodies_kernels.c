@@ -371,20 +371,33 @@ static void test_buoyancy(void) {
   unmake(&t);
 }
 
+/* A free circle of radius 0.1 m about (0.4, 0.4), the given mass and inertia, no lock. */
+static void free_circle(rhod_body *B, double mass, double inertia) {
+  memset(B, 0, sizeof *B);
+  B->name = "f";
+  B->shape.kind = RHOD_SHAPE_CIRCLE;
+  B->shape.center[0] = B->shape.center[1] = 0.4;
+  B->shape.radius = 0.1;
+  B->center[0] = B->center[1] = 0.4;
+  B->motion = RHOD_MOTION_FREE;
+  B->mass = mass, B->inertia = inertia;
+}
+
+/* The unit box's boundary with the scene's bodies in it. */
+static void bodies_in_box(const rhod_scene *sc, rhod_boundary *b, rhod_bodies *bb) {
+  char err[128];
+  const double lo[2] = {0, 0}, hi[2] = {1, 1};
+  CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(b, sc, lo, hi), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_bodies_init(bb, sc, b, 0, 0.5 * DX, err, sizeof err), RHOD_OK);
+}
+
 /* A free body under a constant force: its motion is a parabola, which RK4 and the
  * midpoint rule integrate exactly; a locked degree of freedom keeps its value and rate
  * bit for bit. */
 static void test_free_motion(void) {
   rhod_scene *sc = unit_scene(DX);
   rhod_body B;
-  memset(&B, 0, sizeof B);
-  B.name = "f";
-  B.shape.kind = RHOD_SHAPE_CIRCLE;
-  B.shape.center[0] = B.shape.center[1] = 0.4;
-  B.shape.radius = 0.1;
-  B.center[0] = B.center[1] = 0.4;
-  B.motion = RHOD_MOTION_FREE;
-  B.mass = 2, B.inertia = 0.5;
+  free_circle(&B, 2, 0.5);
   B.velocity[0] = 0.3, B.velocity[1] = 0.7;
   B.lock[0] = 1;
   sc->bodies = &B, sc->n_bodies = 1;
@@ -394,10 +407,7 @@ static void test_free_motion(void) {
         rhod_rk_table_of(method == 0 ? RHOD_INTEGRATOR_RK4 : RHOD_INTEGRATOR_MIDPOINT);
     rhod_boundary b;
     rhod_bodies bb;
-    char err[128];
-    const double lo[2] = {0, 0}, hi[2] = {1, 1};
-    CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&b, sc, lo, hi), RHOD_OK);
-    CU_ASSERT_EQUAL_FATAL(rhod_bodies_init(&bb, sc, &b, 0, 0.5 * DX, err, sizeof err), RHOD_OK);
+    bodies_in_box(sc, &b, &bb);
     const double dt = 0.01;
     double t = 0;
     for (int step = 0; step < 10; step++, t += dt) {
@@ -431,15 +441,8 @@ static void test_free_motion(void) {
 static void test_added_mass_relaxation(void) {
   rhod_scene *sc = unit_scene(DX);
   rhod_body B;
-  memset(&B, 0, sizeof B);
-  B.name = "f";
-  B.shape.kind = RHOD_SHAPE_CIRCLE;
-  B.shape.center[0] = B.shape.center[1] = 0.4;
-  B.shape.radius = 0.1;
-  B.center[0] = B.center[1] = 0.4;
-  B.motion = RHOD_MOTION_FREE;
   const double area = RHOD_PI * 0.01, mA = RHO * area; /* the circle's added mass */
-  B.mass = 0.1 * mA, B.inertia = B.mass * 0.005;
+  free_circle(&B, 0.1 * mA, 0.1 * mA * 0.005);
   B.lock[0] = B.lock[2] = 1;
   sc->bodies = &B, sc->n_bodies = 1;
   const double g[2] = {0, -9.81}, F0 = RHO * 9.81 * area; /* the buoyancy */
@@ -450,10 +453,7 @@ static void test_added_mass_relaxation(void) {
     B.added_mass = relax[c] < 0 ? -1 : relax[c] * mA;
     rhod_boundary b;
     rhod_bodies bb;
-    char err[128];
-    const double lo[2] = {0, 0}, hi[2] = {1, 1};
-    CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&b, sc, lo, hi), RHOD_OK);
-    CU_ASSERT_EQUAL_FATAL(rhod_bodies_init(&bb, sc, &b, 0, 0.5 * DX, err, sizeof err), RHOD_OK);
+    bodies_in_box(sc, &b, &bb);
     rhod_bodies_relaxation(&bb, RHO);
     CU_ASSERT(fabs(bb.b[0].ma[1] - (relax[c] < 0 ? mA : relax[c] * mA)) < 1e-12 * mA);
     double err1 = 0, err8 = 0;
@@ -487,10 +487,7 @@ static void test_added_mass_relaxation(void) {
   B.added_mass = -1;
   rhod_boundary b;
   rhod_bodies bb;
-  char err[128];
-  const double lo[2] = {0, 0}, hi[2] = {1, 1};
-  CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&b, sc, lo, hi), RHOD_OK);
-  CU_ASSERT_EQUAL_FATAL(rhod_bodies_init(&bb, sc, &b, 0, 0.5 * DX, err, sizeof err), RHOD_OK);
+  bodies_in_box(sc, &b, &bb);
   rhod_bodies_relaxation(&bb, RHO);
   double e = 0;
   for (int s = 0; s < 200; s++) {
