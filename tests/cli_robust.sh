@@ -131,7 +131,9 @@ check "bodies: the scene as run reads back identically" -- \
 check "bodies: the same probes" -- cmp "$T/bodies/probes.csv" "$T/bodies2/probes.csv"
 expect 0 "bodies: rhod check" -- "$RHOD" check "$BODIES"
 check "bodies: check prints each body" -- \
-  grep -q "body tri (bodies.1): free polygon, centre \[1.1, 0.333333\].*mass 30 kg/m (density 500 kg/m^3), inertia 0.416667 kg m, locked: x theta" "$T/stdout"
+  grep -q "body tri (bodies.1): free polygon, centre \[1.1, 0.333333\].*mass 30 kg/m (density 500 kg/m^3), inertia 0.416667 kg m, added mass rho0 x area, locked: x theta" "$T/stdout"
+check "bodies: check prints a given added mass" -- \
+  grep -q "body body3 (bodies.3): .*added mass 25 kg/m, locked: none" "$T/stdout"
 check "bodies: check names the fluid left inside them" -- \
   grep -q "left out: 358 inside the body bodies.0 and others" "$T/stdout"
 expect 0 "open boundaries: rhod check" -- "$RHOD" check "$SRC/tests/scenes/good/open_channel.yaml" \
