@@ -35,12 +35,8 @@ void rhod_vorticity(const rhod_cells *c, const rhod_particles *p, int kern, real
       }
     }
     RHOD_END_NEIGHBOURS
-    const real det = b00 * b11 - b01 * b10;
-    if (det > (real)1e-2) {
-      /* Eq. 14: grad phi = L^T s, L = B^-1; du_y/dx = (L^T s_y)_x, du_x/dy = (L^T s_x)_y */
-      w[i] = ((b11 * sy0 - b10 * sy1) - (b00 * sx1 - b01 * sx0)) / det;
-    } else {
-      w[i] = sy0 - sx1;
-    }
+    /* Eq. 14: grad phi = L^T s; du_y/dx = (L^T s_y)_x, du_x/dy = (L^T s_x)_y */
+    RHOD_RENORM_L(b00, b01, b10, b11, L0, L1, L2, L3);
+    w[i] = (L0 * sy0 + L2 * sy1) - (L1 * sx0 + L3 * sx1);
   }
 }

@@ -107,4 +107,20 @@ static inline real rhod_dW(int kind, real r, real R) {
   return rhod_dWq(kind, r * iR) * iR * iR * iR;
 }
 
+/* The renormalisation matrix L = B^-1 of paper 002 Eq. 8, B = [B0 B1; B2 B3] = sum (x_j -
+ * x_i) (x) grad_i W_ij V_j, declared as the reals L0 .. L3 (row-major). Our choice
+ * (docs/choices.md): where det B <= 1e-2, a support too empty to invert (isolated particles,
+ * thin jets), L is the identity and the gradients fall back to the plain SPH sums. The
+ * gradient of a field is then L^T sum (phi_j - phi_i) grad_i W_ij V_j (Eq. 14). A macro:
+ * four outputs, which GCC 12 nvptx would put in a lane-shared frame as pointer outputs. */
+#define RHOD_RENORM_L(B0, B1, B2, B3, L0, L1, L2, L3)                                              \
+  real L0 = 1, L1 = 0, L2 = 0, L3 = 1;                                                             \
+  do {                                                                                             \
+    const real det_ = (B0) * (B3) - (B1) * (B2);                                                   \
+    if (det_ > (real)1e-2) {                                                                       \
+      const real id_ = 1 / det_;                                                                   \
+      L0 = (B3)*id_, L1 = -(B1)*id_, L2 = -(B2)*id_, L3 = (B0)*id_;                                \
+    }                                                                                              \
+  } while (0)
+
 #endif

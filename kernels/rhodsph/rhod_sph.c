@@ -304,15 +304,8 @@ PARTICLE_BODY void pass_a_particle(long i, PA_PARAMS, const int kern) {
   }
   const real Bm[4] = {B0, B1, B2, B3};
   lam[i] = rhod_min_eig_sym(Bm);
-  /* L = B^-1 (Eq. 8). Our choice: where det B < 1e-2 (a support too empty to
-   * invert: isolated particles, thin jets) L = identity, so the gradients fall
-   * back to the plain SPH sums. */
-  const real det = B0 * B3 - B1 * B2;
-  real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
-  if (det > (real)1e-2) {
-    const real id = 1 / det;
-    L0 = B3 * id, L1 = -B1 * id, L2 = -B2 * id, L3 = B0 * id;
-  }
+  /* L = B^-1 (Eq. 8), the identity where B is too near singular (kernel.h) */
+  RHOD_RENORM_L(B0, B1, B2, B3, L0, L1, L2, L3);
   L[4 * i] = L0, L[4 * i + 1] = L1, L[4 * i + 2] = L2, L[4 * i + 3] = L3;
   /* exact for linear fields: sum (a.r) g V = B^T a, so grad = L^T G (scheme.md) */
   gP[2 * i] = L0 * GPx + L2 * GPy;
@@ -1291,12 +1284,7 @@ real rhod_sph_damper_probe(rhod_sph *s, rhod_particles *p, const rhod_cells *c) 
     const real G0 = RHOD_LANES_SUM(sG0), G1 = RHOD_LANES_SUM(sG1), G2 = RHOD_LANES_SUM(sG2),
                G3 = RHOD_LANES_SUM(sG3);
     aD[i] = G0 + G3;
-    const real det = B0 * B3 - B1 * B2;
-    real L0 = 1, L1 = 0, L2 = 0, L3 = 1;
-    if (det > (real)1e-2) {
-      const real id_ = 1 / det;
-      L0 = B3 * id_, L1 = -B1 * id_, L2 = -B2 * id_, L3 = B0 * id_;
-    }
+    RHOD_RENORM_L(B0, B1, B2, B3, L0, L1, L2, L3);
     aG[4 * i] = L0 * G0 + L2 * G1, aG[4 * i + 1] = L1 * G0 + L3 * G1;
     aG[4 * i + 2] = L0 * G2 + L2 * G3, aG[4 * i + 3] = L1 * G2 + L3 * G3;
   }
