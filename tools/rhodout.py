@@ -85,6 +85,14 @@ def summary(out):
         return json.load(f)
 
 
+def finished(out):
+    """Whether OUT holds a run that ended well (summary.json's status "ok")."""
+    try:
+        return summary(out).get("status") == "ok"
+    except (OSError, ValueError):
+        return False
+
+
 def refdata(path):
     """Columns of a reference CSV (comment lines start with #, then a header row)."""
     with open(path) as f:
