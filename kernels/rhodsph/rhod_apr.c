@@ -344,17 +344,16 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
       CRITERIA_SUMS(i, Ri, quarter, lower, dxi, crowd, same, num, den, grand, crowded);
     const real phi = num / den;
     const int in3 = c3 && (reg[i] == 2 || (reg[i] == 1 && (band >= 1 || sig[i] > sband)));
-    /* a held region (ours, refinement.regions.N.hold) asking for a finer size here */
-    const int inh = nh && held_dx(nh, hr, hp, xi, yi, 0) < dxi * (1 - RHOD_SIZE_TOL);
+    /* last, a held region (ours, refinement.regions.N.hold) asking for a finer size here */
     const int m = can_split && (grand || crowded || same < 2 * self || in3 || (c4 && near[i]) ||
-                                (c5 && (phi > above || phi < below)) || inh);
+                                (c5 && (phi > above || phi < below)) ||
+                                (nh && held_dx(nh, hr, hp, xi, yi, 0) < dxi * (1 - RHOD_SIZE_TOL)));
     mark[i] = (uint8_t)m;
     /* nor may a group merge within one merged size e dx_i of a region that asks for
      * less than that size: the merged particle, at most dx_i from each member, would
      * stand in the region or split again as soon as it drifted in */
-    const int nearh =
-        nh && held_dx(nh, hr, hp, xi, yi, eps * dxi) < eps * dxi * (1 - RHOD_SIZE_TOL);
-    if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i]) && !nearh) {
+    if (!m && co && dxi <= dgrow && !in3 && !(c4 && near2[i]) &&
+        !(nh && held_dx(nh, hr, hp, xi, yi, eps * dxi) < eps * dxi * (1 - RHOD_SIZE_TOL))) {
       /* Coalescing candidate: the criteria for the particle of size D = e dx_i at x_i
        * (HYST above). Criterion 3 first: no free-surface particle within HYST f e R_i,
        * looked for among the free-surface particles alone (the subset cells fsc that the
