@@ -1221,6 +1221,84 @@ static void coalesce_groups(rhod_pattern pattern) {
   free(sc);
 }
 
+/* Criterion 5's three fields (Sec. V B; Sec. VI F's P - rho0 g.(x - x0)) on a hydrostatic
+ * block under g = (0, -9.81) with its surface at y0 = 0.2 and a uniform stream u0: the
+ * marks against the block's marks with criterion 5 off (criteria 1-2 at its edges). */
+static long marks_beyond(rhod_apr *a, rhod_sph *s, rhod_particles *p, rhod_cells *c,
+                         const uint8_t *base, long n, long *fewer) {
+  CU_ASSERT_EQUAL_FATAL(rhod_apr_mark(a, s, p, c, &nowalls, 0, 0), RHOD_OK);
+  rhod_to_host(a->mark, (size_t)n);
+  long more = 0;
+  *fewer = 0;
+  for (long i = 0; i < n; i++)
+    more += a->mark[i] && !base[i], *fewer += base[i] && !a->mark[i];
+  return more;
+}
+static void test_criterion_5_fields(void) {
+  const double dx = 0.01, rho0 = 1000, c0 = 20, g = 9.81, y0 = 0.2, u0 = 0.3;
+  rhod_scene *sc = unit_scene(dx);
+  sc->gravity[1] = -g;
+  rhod_particles p;
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, 400), RHOD_OK);
+  unsigned long seed = 5;
+  add_block(&p, 0, 0, 20, 20, dx, 0, &seed);
+  const long n = (long)p.n;
+  for (long i = 0; i < n; i++) {
+    p.rho[i] = (real)(rho0 + rho0 * g * (y0 - p.y[i]) / (c0 * c0)); /* P = rho0 g (y0 - y) */
+    p.m[i] = (real)(p.rho[i] * dx * dx), p.ux[i] = (real)u0;
+  }
+  const double lo[2] = {-8 * dx, -8 * dx}, hi[2] = {28 * dx, 28 * dx};
+  rhod_sph s;
+  rhod_cells c;
+  rhod_apr a;
+  mark_store(sc, &p, &s, &c, &a, lo, hi, dx, dx / 2); /* criterion 5 off */
+  rhod_to_host(a.mark, (size_t)n);
+  uint8_t *base = malloc((size_t)n);
+  memcpy(base, a.mark, (size_t)n);
+  long nbase = 0;
+  for (long i = 0; i < n; i++)
+    nbase += base[i];
+  CU_ASSERT(nbase < n / 2);
+  const double half = rho0 * g * (y0 - 0.1); /* P at mid-depth */
+  struct {
+    rhod_quantity q;
+    double x0y, above, below;
+    long lo, hi; /* marks beyond the base's expected */
+  } cases[] = {
+      /* P: the deeper half (Shepard-averaged: a row either side of mid-depth may go) */
+      {RHOD_QTY_PRESSURE, 0, half, -1e30, 8 * 20, 12 * 20},
+      /* P - rho0 g.(x - x0), x0 on the surface: zero everywhere, nothing marked */
+      {RHOD_QTY_HYDRODYNAMIC_PRESSURE, y0, 0.01 * half, -0.01 * half, 0, 0},
+      /* x0 three rows lower: rho0 g 3 dx everywhere, every particle marked */
+      {RHOD_QTY_HYDRODYNAMIC_PRESSURE, y0 - 3 * dx, 0.9 * rho0 * g * 3 * dx, -1e30, n - nbase,
+       n - nbase},
+      {RHOD_QTY_HYDRODYNAMIC_PRESSURE, y0 - 3 * dx, 1.1 * rho0 * g * 3 * dx, -1e30, 0, 0},
+      /* rho |u|^2 / 2 = 45 Pa (rho within 0.5 % of rho0) */
+      {RHOD_QTY_DYNAMIC_PRESSURE, 0, 44, -1e30, n - nbase, n - nbase},
+      {RHOD_QTY_DYNAMIC_PRESSURE, 0, 46, 44.5, 0, 0},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+    sc->rs->refine_field = 1, sc->rs->field_quantity = cases[k].q;
+    sc->rs->field_above = cases[k].above, sc->rs->field_below = cases[k].below;
+    sc->rs->field_x0[0] = 0, sc->rs->field_x0[1] = cases[k].x0y;
+    rhod_apr_free(&a);
+    CU_ASSERT_EQUAL_FATAL(rhod_apr_init(&a, sc, dx / 2), RHOD_OK);
+    long fewer;
+    const long more = marks_beyond(&a, &s, &p, &c, base, n, &fewer);
+    CU_ASSERT_EQUAL(fewer, 0);
+    CU_ASSERT(more >= cases[k].lo && more <= cases[k].hi);
+    if (!(more >= cases[k].lo && more <= cases[k].hi))
+      printf("\n  criterion 5 case %zu: %ld marked beyond the base, expected %ld-%ld\n", k, more,
+             cases[k].lo, cases[k].hi);
+  }
+  free(base);
+  rhod_apr_free(&a);
+  rhod_sph_free(&s);
+  rhod_cells_free(&c);
+  rhod_particles_free(&p);
+  free(sc);
+}
+
 static void test_coalesce_groups(void) { coalesce_groups(RHOD_PATTERN_SQUARE); }
 static void test_coalesce_groups_triangle(void) { coalesce_groups(RHOD_PATTERN_TRIANGLE); }
 
@@ -1862,6 +1940,7 @@ int main(void) {
       {"... and apart, from a parent almost on a wall", test_split_near_wall_keeps_spacing},
       {"dx_min is never crossed", test_dx_min_never_crossed},
       {"criteria 1 and 2", test_criteria_1_2},
+      {"criterion 5: pressure, dynamic and hydrodynamic pressure", test_criterion_5_fields},
       {"coalescing groups and conservation", test_coalesce_groups},
       {"... also in groups of three (triangle)", test_coalesce_groups_triangle},
       {"coalescing in a run: merges back, never splits again", test_coalesce_run},

@@ -314,6 +314,8 @@ static const struct {
     {"refine_criterion_one_level.yaml", 11, "refinement.levels", "need at least 2 levels"},
     {"refine_field_no_threshold.yaml", 12, "refinement.field", "needs a threshold"},
     {"refine_field_quantity.yaml", 12, "refinement.field.quantity", "invalid value"},
+    {"refine_field_no_x0.yaml", 12, "refinement.field", "needs x0"},
+    {"refine_field_x0_unused.yaml", 12, "refinement.field.x0", "hydrodynamic_pressure only"},
     {"refine_free_surface_no_detection.yaml", 14, "refinement.free_surface",
      "needs the free-surface detection"},
     {"refine_coalesce_static.yaml", 13, "refinement.coalesce", "needs dynamic refinement"},

@@ -109,7 +109,12 @@ int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   a->crowd = (real)sc->rs->refine_crowding;
   a->walls = sc->rs->refine_walls;
   a->field = sc->rs->refine_field;
-  a->qty = sc->rs->field_quantity;
+  const rhod_quantity q = sc->rs->field_quantity;
+  const double *g = sc->gravity, *x0 = sc->rs->field_x0, rho0 = sc->rs->rho0;
+  const int hyd = q == RHOD_QTY_HYDRODYNAMIC_PRESSURE;
+  a->fc[0] = q != RHOD_QTY_DYNAMIC_PRESSURE, a->fc[1] = q == RHOD_QTY_DYNAMIC_PRESSURE;
+  a->fc[2] = hyd ? (real)(-rho0 * g[0]) : 0, a->fc[3] = hyd ? (real)(-rho0 * g[1]) : 0;
+  a->fc[4] = hyd ? (real)(rho0 * (g[0] * x0[0] + g[1] * x0[1])) : 0;
   a->above = (real)fmin(sc->rs->field_above, 1e30);
   a->below = (real)fmax(sc->rs->field_below, -1e30);
   a->from = (real)sc->rs->field_from;
@@ -201,10 +206,13 @@ static int ensure(rhod_apr *a, size_t n) {
              : RHOD_ERR_MEMORY;
 }
 
-/* The field of criterion 5 of a particle: P, or the dynamic pressure rho |u|^2 / 2. */
-static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
-  return dyn ? (real)0.5 * rho * (ux * ux + uy * uy) : P;
-}
+/* The field of criterion 5 of a particle at (x, y): fc[0] P + fc[1] rho |u|^2 / 2 + fc[2] x +
+ * fc[3] y + fc[4], one branch-free form for P (fc = 1, 0, 0, 0, 0), the dynamic pressure
+ * rho |u|^2 / 2 (0, 1, 0, 0, 0) and paper 002 Sec. VI F's P - rho0 g.(x - x0)
+ * (1, 0, -rho0 g_x, -rho0 g_y, rho0 g.x0); rhod_apr_init sets fc. Scalars, not the array,
+ * in the kernels (FIELD_OF), which copy them in as firstprivate. */
+#define FIELD_OF(rho, ux, uy, P, x, y)                                                             \
+  (fcP * (P) + fcK * (real)0.5 * (rho) * ((ux) * (ux) + (uy) * (uy)) + fcX * (x) + fcY * (y) + fc1)
 
 /* Sums of the criteria over the neighbours j within R of particle i (r_ij > 0, which
  * leaves i out), added to the variables named (which hold the self terms): Gamma_ij =
@@ -217,8 +225,8 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
  * coalescing group would make. Reads the rows the last right-hand side packed in cell
  * order (RHOD_PK_*) in vector lanes (cells.h RHOD_FOR_LANES), as the scheme's gathers do.
  * A macro over the marking loop's locals (G, CS, x, y, kx, ky, kV, kdx, kP, kux, kuy,
- * krho, kern, dyn), not a function: GCC 12 nvptx puts a returned struct, like pointer
- * outputs, in the warp-shared frame (tests/offload_frames.sh). */
+ * krho, kern, fcP, fcK, fcX, fcY, fc1), not a function: GCC 12 nvptx puts a returned struct, like
+ * pointer outputs, in the warp-shared frame (tests/offload_frames.sh). */
 #define CRITERIA_SUMS(i, R, small, big, own, ck, same, num, den, anysmall, crowded)                \
   {                                                                                                \
     const real xs_ = x[i], ys_ = y[i], iR_ = 1 / (R), iR2_ = iR_ * iR_;                            \
@@ -237,7 +245,7 @@ static inline real field_of(int dyn, real rho, real ux, real uy, real P) {
         RHOD_LANE(scrowd_) = cr_ ? 1 : RHOD_LANE(scrowd_);                                         \
         const real w_ = rhod_Wq(kern, sqrt(r2_) * iR_) * iR2_ * kV[k_];                            \
         RHOD_LANE(ssame_) += dxj_ >= (big) ? w_ : 0;                                               \
-        const real phij_ = field_of(dyn, krho[k_], kux[k_], kuy[k_], kP[k_]);                      \
+        const real phij_ = FIELD_OF(krho[k_], kux[k_], kuy[k_], kP[k_], kx[k_], ky[k_]);           \
         RHOD_LANE(snum_) += w_ * phij_, RHOD_LANE(sden_) += w_;                                    \
       }                                                                                            \
       RHOD_END_LANES                                                                               \
@@ -310,7 +318,8 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
    * coarse neighbour (cases/rotating_square/RESULTS.md, "Bursts at the size jumps");
    * splitting the coarse one leaves pairs of one size, which single resolution bears. */
   const real crowd = a->crowd;
-  const int c5 = a->field && (real)t >= a->from, dyn = a->qty == RHOD_QTY_DYNAMIC_PRESSURE;
+  const int c5 = a->field && (real)t >= a->from;
+  const real fcP = a->fc[0], fcK = a->fc[1], fcX = a->fc[2], fcY = a->fc[3], fc1 = a->fc[4];
   const real above = a->above, below = a->below;
   const int nh = a->nhold;
   const real *hr = a->hr, *hp = a->hp;
@@ -333,7 +342,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
     }
     const real iR = 1 / Ri, iR2 = iR * iR;
     const real self = rhod_Wq(kern, 0) * iR2 * V[i]; /* Gamma_ii, Eq. 7 */
-    const real phii = field_of(dyn, rho[i], ux[i], uy[i], P[i]);
+    const real phii = FIELD_OF(rho[i], ux[i], uy[i], P[i], xi, yi);
     /* criterion 1: a neighbour two levels finer, dx_i / e^2 (dx_i / 4 at e = 2) */
     const real quarter = dxi * ieps * ieps * (1 + RHOD_SIZE_TOL), lower = dxi * (1 - RHOD_SIZE_TOL);
     real same = self; /* criterion 2: sum of Gamma_ij over dx_j >= dx_i, i included */

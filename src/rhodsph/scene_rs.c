@@ -36,6 +36,7 @@ static const cyaml_strval_t pattern_names[] = {
 static const cyaml_strval_t quantity_names[] = {
     {"pressure", RHOD_QTY_PRESSURE},
     {"dynamic_pressure", RHOD_QTY_DYNAMIC_PRESSURE},
+    {"hydrodynamic_pressure", RHOD_QTY_HYDRODYNAMIC_PRESSURE},
 };
 
 static const cyaml_schema_field_t f_region[] = {
@@ -53,6 +54,8 @@ static const cyaml_schema_field_t f_refine_field[] = {
     RHOD_RS_NUM_("above", y_rs_refine_field, above),
     RHOD_RS_NUM_("below", y_rs_refine_field, below),
     RHOD_RS_NUM_("from", y_rs_refine_field, from),
+    CYAML_FIELD_SEQUENCE_FIXED("x0", RHOD_RS_OPT_ | CYAML_FLAG_FLOW, y_rs_refine_field, x0,
+                               &rhod_sl_sch_float, 2),
     CYAML_FIELD_END,
 };
 
@@ -276,6 +279,14 @@ int rhod_rs_load_refinement(lctx *c, const y_rs_refinement *r, rhod_scene *s) {
     rs->field_above = f->above ? *f->above : HUGE_VAL;
     rs->field_below = f->below ? *f->below : -HUGE_VAL;
     rs->field_from = opt(f->from, 0);
+    const int hyd = rs->field_quantity == RHOD_QTY_HYDRODYNAMIC_PRESSURE;
+    if (hyd != (f->x0 != NULL))
+      return rhod_sl_fail(c, hyd ? "refinement.field" : "refinement.field.x0",
+                          hyd ? "quantity hydrodynamic_pressure needs x0, the reference "
+                                "point of the free surface (P - rho0 g.(x - x0))"
+                              : "is the reference point of quantity hydrodynamic_pressure only");
+    for (int d = 0; d < 2; d++)
+      rs->field_x0[d] = hyd ? f->x0[d] : 0;
     if (f->above && f->below && !(rs->field_below < rs->field_above))
       return rhod_sl_fail(c, "refinement.field.below",
                           "(%g) must be below refinement.field.above (%g)", rs->field_below,
@@ -399,5 +410,7 @@ void rhod_rs_tree_refinement(rhod_sl_tb *t, ry_node *root, const rhod_rs_scene *
     if (rs->field_below != -HUGE_VAL)
       rhod_sl_num(t, e, "below", rs->field_below);
     rhod_sl_num(t, e, "from", rs->field_from);
+    if (rs->field_quantity == RHOD_QTY_HYDRODYNAMIC_PRESSURE)
+      rhod_sl_vec(t, e, "x0", rs->field_x0);
   }
 }

@@ -58,6 +58,7 @@ typedef struct {
 typedef struct {
   int quantity;
   double *above, *below, *from;
+  double *x0;
 } y_rs_refine_field;
 
 typedef struct {

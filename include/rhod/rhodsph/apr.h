@@ -32,7 +32,7 @@ typedef struct {
                        times the mean of the two sizes (ours; 0: off) */
   int walls;        /* criterion 4 */
   int field;        /* criterion 5 */
-  rhod_quantity qty;
+  real fc[5];       /* its field, fc . (P, rho |u|^2 / 2, x, y, 1) (rhod_apr.c FIELD_OF) */
   real above, below, from;
   int nsplit;     /* children per split: 4 (square pattern) or 3 (triangle) */
   real eps, ieps; /* size ratio of adjacent levels (2 or sqrt 3) and its inverse */

@@ -69,7 +69,14 @@ typedef struct {
 } rhod_region;
 
 /* The field of refinement criterion 5 (paper 002 Sec. V B), Shepard-averaged. */
-typedef enum { RHOD_QTY_PRESSURE = 0, RHOD_QTY_DYNAMIC_PRESSURE } rhod_quantity;
+/* criterion 5's field: P; rho |u|^2 / 2; or P - rho0 g.(x - x0), the pressure less the
+ * hydrostatic one about the free surface's reference point x0 (paper 002 Sec. VI F, which
+ * calls it the dynamic pressure component) */
+typedef enum {
+  RHOD_QTY_PRESSURE = 0,
+  RHOD_QTY_DYNAMIC_PRESSURE,
+  RHOD_QTY_HYDRODYNAMIC_PRESSURE
+} rhod_quantity;
 
 typedef struct rhod_rs_scene {
   /* time: */
@@ -127,6 +134,7 @@ typedef struct rhod_rs_scene {
   rhod_quantity field_quantity;    /* refinement.field.quantity */
   double field_above, field_below; /* thresholds (+-HUGE_VAL when absent) */
   double field_from;               /* refinement.field.from [s], default 0 */
+  double field_x0[2]; /* refinement.field.x0 [m]: hydrodynamic_pressure's reference point */
 } rhod_rs_scene;
 
 void rhod_rs_scene_free(rhod_rs_scene *rs);
