@@ -68,10 +68,10 @@ typedef struct {
   int hold; /* refinement.regions.N.hold: kept at its level during the run (ours) */
 } rhod_region;
 
-/* The field of refinement criterion 5 (paper 002 Sec. V B), Shepard-averaged. */
-/* criterion 5's field: P; rho |u|^2 / 2; or P - rho0 g.(x - x0), the pressure less the
- * hydrostatic one about the free surface's reference point x0 (paper 002 Sec. VI F, which
- * calls it the dynamic pressure component) */
+/* The field of refinement criterion 5 (paper 002 Sec. V B), Shepard-averaged: P;
+ * rho |u|^2 / 2; or P - rho0 g.(x - x0), the pressure less the hydrostatic one below the
+ * free surface's reference point x0 (Sec. VI F, which calls it the dynamic pressure
+ * component). */
 typedef enum {
   RHOD_QTY_PRESSURE = 0,
   RHOD_QTY_DYNAMIC_PRESSURE,
