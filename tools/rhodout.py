@@ -19,6 +19,25 @@ import h5py
 import numpy as np
 
 
+def law(text, t):
+    """A libmatheval expression of t (a scene's velocity or motion law) in Python."""
+    import math
+    names = {k: getattr(math, k) for k in ("exp", "sin", "cos", "tanh", "sqrt", "log", "pi")}
+    names.update(t=t, abs=abs, min=min, max=max)
+    return float(eval(text.strip('"').replace("^", "**"), {"__builtins__": {}}, names))
+
+
+def lowpass(t, f, fcut):
+    """f(t) low-passed at fcut: Butterworth order 4 forward and backward (paper 002
+    Sec. VI E's filter of the forces); f as it is when fcut is beyond Nyquist or f is short."""
+    from scipy.signal import butter, filtfilt
+    dt = np.median(np.diff(t))
+    if fcut * 2 * dt >= 1 or len(f) < 16:
+        return f
+    b, a = butter(4, fcut * 2 * dt)
+    return filtfilt(b, a, f)
+
+
 def snapshots(out):
     """Sorted list of snapshot paths in an output folder."""
     return sorted(glob.glob(os.path.join(out, "snapshot_*.h5")))
