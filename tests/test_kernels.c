@@ -267,6 +267,75 @@ static void test_renormalised_gradient_linear(void) {
   cloud_free(&cl);
 }
 
+/* The ghosts' velocity divergence (rhod_sph_mirror_gradients; docs/choices.md "ghost values"):
+ * a free-slip mirror, plane (T = J) or a circle's curved one (T = k (I - e e^T) - e e^T,
+ * kernels/ghosts.c), carries its source's raw D as the pressure is mirrored; no slip (T = -I)
+ * and an outflow (T = I) the trace of the mapped gradient T grad u J^T. The curved mirror's
+ * trace, k U_tt + U_nn, pushed a cylinder moving through still water along its velocity
+ * (cases/body_free/RESULTS.md). */
+static void test_ghost_divergence(void) {
+  cloud cl;
+  const double dx = 0.01;
+  cloud_make(&cl, 12, 12, dx, 0.3, 11);
+  rhod_particles *p = &cl.p;
+  for (size_t i = 0; i < p->n; i++) {
+    const double x = p->x[i], y = p->y[i];
+    p->ux[i] = (real)(2 * x - y + 3 * x * y), p->uy[i] = (real)(x + 0.5 * y - y * y);
+  }
+  cloud_rhs(&cl);
+  rhod_sph *s = &cl.s;
+  const size_t n = p->n;
+  rhod_to_host(s->D, n * sizeof(real));
+  rhod_to_host(s->gu, 4 * n * sizeof(real));
+  rhod_to_host(s->gP, 2 * n * sizeof(real));
+  const int k = 66; /* an inner particle */
+  const double ex = 0.6, ey = 0.8; /* the wall's normal at the mirror */
+  const double J[4] = {1 - 2 * ex * ex, -2 * ex * ey, -2 * ex * ey, 1 - 2 * ey * ey};
+  const double kc = 0.8; /* r_g / r_s of a curved mirror */
+  const double T[4][4] = {
+      {J[0], J[1], J[2], J[3]},                                               /* plane */
+      {kc - (1 + kc) * ex * ex, -(1 + kc) * ex * ey, -(1 + kc) * ex * ey,     /* curved */
+       kc - (1 + kc) * ey * ey},
+      {-1, 0, 0, -1}, /* no slip */
+      {1, 0, 0, 1},   /* outflow */
+  };
+  p->ng = 4;
+  for (int q = 0; q < 4; q++) {
+    const size_t g = n + (size_t)q;
+    p->x[g] = p->x[k] - (real)(2 * dx * ex), p->y[g] = p->y[k] - (real)(2 * dx * ey);
+    p->rho[g] = p->rho[k], p->m[g] = p->m[k], p->dx[g] = p->dx[k];
+    p->gsrc[g] = k;
+    for (int e = 0; e < 4; e++)
+      p->gJ[4 * g + e] = (real)J[e], p->gT[4 * g + e] = (real)T[q][e];
+  }
+  rhod_to_device(p->rho, (n + 4) * sizeof(real));
+  rhod_to_device(p->gsrc, (n + 4) * sizeof(int32_t));
+  rhod_to_device(p->gJ, 4 * (n + 4) * sizeof(real));
+  rhod_to_device(p->gT, 4 * (n + 4) * sizeof(real));
+  rhod_sph_mirror_gradients(s, p);
+  rhod_to_host(s->D, (n + 4) * sizeof(real));
+  const real *U = s->gu + 4 * k;
+  double tr[4];
+  for (int q = 0; q < 4; q++) { /* tr(T U J^T) */
+    const double *t = T[q];
+    tr[q] = 0;
+    for (int a = 0; a < 2; a++)
+      for (int b = 0; b < 2; b++)
+        tr[q] += (t[2 * a] * U[b] + t[2 * a + 1] * U[2 + b]) * J[2 * a + b];
+  }
+  printf("\n  D_k %.6g; ghosts: plane %.6g, curved %.6g (trace %.6g), no slip %.6g (trace %.6g), "
+         "outflow %.6g (trace %.6g)\n",
+         s->D[k], s->D[n], s->D[n + 1], tr[1], s->D[n + 2], tr[2], s->D[n + 3], tr[3]);
+  CU_ASSERT(fabs(s->D[k]) > 0.5);         /* a divergent field, so that the maps differ */
+  CU_ASSERT(fabs(tr[1] - s->D[k]) > 0.1); /* the curved mirror's trace is not D_k */
+  CU_ASSERT_EQUAL(s->D[n], s->D[k]);
+  CU_ASSERT_EQUAL(s->D[n + 1], s->D[k]);
+  CU_ASSERT_DOUBLE_EQUAL(s->D[n + 2], tr[2], TOL(1e-12, 1e-4));
+  CU_ASSERT_DOUBLE_EQUAL(s->D[n + 3], tr[3], TOL(1e-12, 1e-4));
+  p->ng = 0;
+  cloud_free(&cl);
+}
+
 /* The viscous operators on a strongly disordered cloud (jitter 0.5 dx), a divergence-free
  * quadratic velocity u = (x^2 - 2xy + 3y^2, -x^2 - 2xy + y^2), lap u = (8, 0) 1/m s,
  * no pressure and only viscosity acting: acc = mu lap u / rho. */
@@ -1337,6 +1406,8 @@ int main(void) {
       {"RK4 stages' stiffness: the rate of a linear system", test_rk_stiffness},
       {"wall-crossing guard, corners included", test_walls_guard},
       {"damper step limit: the probe finds Eq. 9's largest eigenvalue", test_damper_probe},
+      {"ghost divergence: free-slip mirrors carry D, the other maps their trace",
+       test_ghost_divergence},
   };
   return RHOD_RUN_TESTS("kernels", cases);
 }
