@@ -288,13 +288,13 @@ static void test_ghost_divergence(void) {
   rhod_to_host(s->D, n * sizeof(real));
   rhod_to_host(s->gu, 4 * n * sizeof(real));
   rhod_to_host(s->gP, 2 * n * sizeof(real));
-  const int k = 66; /* an inner particle */
+  const int k = 66;                /* an inner particle */
   const double ex = 0.6, ey = 0.8; /* the wall's normal at the mirror */
   const double J[4] = {1 - 2 * ex * ex, -2 * ex * ey, -2 * ex * ey, 1 - 2 * ey * ey};
   const double kc = 0.8; /* r_g / r_s of a curved mirror */
   const double T[4][4] = {
-      {J[0], J[1], J[2], J[3]},                                               /* plane */
-      {kc - (1 + kc) * ex * ex, -(1 + kc) * ex * ey, -(1 + kc) * ex * ey,     /* curved */
+      {J[0], J[1], J[2], J[3]},                                           /* plane */
+      {kc - (1 + kc) * ex * ex, -(1 + kc) * ex * ey, -(1 + kc) * ex * ey, /* curved */
        kc - (1 + kc) * ey * ey},
       {-1, 0, 0, -1}, /* no slip */
       {1, 0, 0, 1},   /* outflow */
