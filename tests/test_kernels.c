@@ -268,11 +268,11 @@ static void test_renormalised_gradient_linear(void) {
 }
 
 /* The ghosts' velocity divergence (rhod_sph_mirror_gradients; docs/choices.md "ghost values"):
- * a free-slip mirror, plane (T = J) or a circle's curved one (T = k (I - e e^T) - e e^T,
- * kernels/ghosts.c), carries its source's raw D as the pressure is mirrored; no slip (T = -I)
- * and an outflow (T = I) the trace of the mapped gradient T grad u J^T. The curved mirror's
- * trace, k U_tt + U_nn, pushed a cylinder moving through still water along its velocity
- * (cases/body_free/RESULTS.md). */
+ * a free-slip mirror, plane (T = J), a corner's double one (T = J = -I) or a circle's curved
+ * one (T = k (I - e e^T) - e e^T, kernels/ghosts.c), carries its source's raw D as the pressure
+ * is mirrored; no slip (T = -I under a single mirror) and an outflow (T = I) the trace of the
+ * mapped gradient T grad u J^T. The curved mirror's trace, k U_tt + U_nn, pushed a cylinder
+ * moving through still water along its velocity (cases/body_free/RESULTS.md). */
 static void test_ghost_divergence(void) {
   cloud cl;
   const double dx = 0.01;
@@ -288,50 +288,59 @@ static void test_ghost_divergence(void) {
   rhod_to_host(s->D, n * sizeof(real));
   rhod_to_host(s->gu, 4 * n * sizeof(real));
   rhod_to_host(s->gP, 2 * n * sizeof(real));
+  enum { NG = 5 };
   const int k = 66;                /* an inner particle */
   const double ex = 0.6, ey = 0.8; /* the wall's normal at the mirror */
-  const double J[4] = {1 - 2 * ex * ex, -2 * ex * ey, -2 * ex * ey, 1 - 2 * ey * ey};
+  const double M[4] = {1 - 2 * ex * ex, -2 * ex * ey, -2 * ex * ey, 1 - 2 * ey * ey};
   const double kc = 0.8; /* r_g / r_s of a curved mirror */
-  const double T[4][4] = {
-      {J[0], J[1], J[2], J[3]},                                           /* plane */
+  const double J[NG][4] = {
+      {M[0], M[1], M[2], M[3]}, {M[0], M[1], M[2], M[3]}, {M[0], M[1], M[2], M[3]},
+      {M[0], M[1], M[2], M[3]}, {-1, 0, 0, -1}, /* a corner's double mirror */
+  };
+  const double T[NG][4] = {
+      {M[0], M[1], M[2], M[3]},                                           /* plane */
       {kc - (1 + kc) * ex * ex, -(1 + kc) * ex * ey, -(1 + kc) * ex * ey, /* curved */
        kc - (1 + kc) * ey * ey},
       {-1, 0, 0, -1}, /* no slip */
       {1, 0, 0, 1},   /* outflow */
+      {-1, 0, 0, -1}, /* the corner: free slip on both walls */
   };
-  p->ng = 4;
-  for (int q = 0; q < 4; q++) {
+  p->ng = NG;
+  for (int q = 0; q < NG; q++) {
     const size_t g = n + (size_t)q;
     p->x[g] = p->x[k] - (real)(2 * dx * ex), p->y[g] = p->y[k] - (real)(2 * dx * ey);
     p->rho[g] = p->rho[k], p->m[g] = p->m[k], p->dx[g] = p->dx[k];
     p->gsrc[g] = k;
     for (int e = 0; e < 4; e++)
-      p->gJ[4 * g + e] = (real)J[e], p->gT[4 * g + e] = (real)T[q][e];
+      p->gJ[4 * g + e] = (real)J[q][e], p->gT[4 * g + e] = (real)T[q][e];
   }
-  rhod_to_device(p->rho, (n + 4) * sizeof(real));
-  rhod_to_device(p->gsrc, (n + 4) * sizeof(int32_t));
-  rhod_to_device(p->gJ, 4 * (n + 4) * sizeof(real));
-  rhod_to_device(p->gT, 4 * (n + 4) * sizeof(real));
+  rhod_to_device(p->rho, (n + NG) * sizeof(real));
+  rhod_to_device(p->gsrc, (n + NG) * sizeof(int32_t));
+  rhod_to_device(p->gJ, 4 * (n + NG) * sizeof(real));
+  rhod_to_device(p->gT, 4 * (n + NG) * sizeof(real));
   rhod_sph_mirror_gradients(s, p);
-  rhod_to_host(s->D, (n + 4) * sizeof(real));
+  rhod_to_host(s->D, (n + NG) * sizeof(real));
   const real *U = s->gu + 4 * k;
-  double tr[4];
-  for (int q = 0; q < 4; q++) { /* tr(T U J^T) */
-    const double *t = T[q];
+  double tr[NG];
+  for (int q = 0; q < NG; q++) { /* tr(T U J^T) */
+    const double *t = T[q], *j = J[q];
     tr[q] = 0;
     for (int a = 0; a < 2; a++)
       for (int b = 0; b < 2; b++)
-        tr[q] += (t[2 * a] * U[b] + t[2 * a + 1] * U[2 + b]) * J[2 * a + b];
+        tr[q] += (t[2 * a] * U[b] + t[2 * a + 1] * U[2 + b]) * j[2 * a + b];
   }
   printf("\n  D_k %.6g; ghosts: plane %.6g, curved %.6g (trace %.6g), no slip %.6g (trace %.6g), "
-         "outflow %.6g (trace %.6g)\n",
-         s->D[k], s->D[n], s->D[n + 1], tr[1], s->D[n + 2], tr[2], s->D[n + 3], tr[3]);
-  CU_ASSERT(fabs(s->D[k]) > 0.5);         /* a divergent field, so that the maps differ */
-  CU_ASSERT(fabs(tr[1] - s->D[k]) > 0.1); /* the curved mirror's trace is not D_k */
+         "outflow %.6g (trace %.6g), corner %.6g (trace %.6g)\n",
+         s->D[k], s->D[n], s->D[n + 1], tr[1], s->D[n + 2], tr[2], s->D[n + 3], tr[3], s->D[n + 4],
+         tr[4]);
+  CU_ASSERT(fabs(s->D[k]) > 0.5);          /* a divergent field, so that the maps differ */
+  CU_ASSERT(fabs(tr[1] - s->D[k]) > 0.1);  /* the curved mirror's trace is not D_k */
+  CU_ASSERT(fabs(tr[4] - s->D[k]) > 1e-3); /* nor is the corner's (renormalised against raw) */
   CU_ASSERT_EQUAL(s->D[n], s->D[k]);
   CU_ASSERT_EQUAL(s->D[n + 1], s->D[k]);
   CU_ASSERT_DOUBLE_EQUAL(s->D[n + 2], tr[2], TOL(1e-12, 1e-4));
   CU_ASSERT_DOUBLE_EQUAL(s->D[n + 3], tr[3], TOL(1e-12, 1e-4));
+  CU_ASSERT_EQUAL(s->D[n + 4], s->D[k]);
   p->ng = 0;
   cloud_free(&cl);
 }

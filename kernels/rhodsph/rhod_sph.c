@@ -398,22 +398,25 @@ void rhod_sph_pass_a(rhod_sph *s, rhod_particles *p, const rhod_cells *c) {
 
 /* div u of a ghost (shared by rhod_sph_mirror_gradients and the damper probe). Where the map
  * is a free-slip mirror, one that reverses the normal velocity and keeps the tangential one's
- * sign (the plane mirror T = J, a circle's curved mirror T = k (I - e e^T) - e e^T with
- * k = r_g/r_s > 0, kernels/ghosts.c, and the periodic images T = J = I), the source's own raw
- * (Eq. 5) value Dk: D enters Eq. 9 as P does Eq. 6, so its ghost mirrors it as the pressure
- * is mirrored. Elsewhere (no slip T = -I, the open boundaries' maps) the trace of the mapped
- * gradient (T U) J^T, U the source's renormalised gradient (row-major). The curved mirror's
- * trace, k U_tt + U_nn, would add (k - 1) U_tt = O(dx/a) |u - u_w|/a, a damper pressure of
- * order alpha rho0 c0 R |u - u_w| dx/a^2 that pushes a moving cylinder along its velocity
- * (docs/choices.md "ghost values"). e e^T = (I - J)/2: the normal test is T (I - J) = -(I - J),
- * and tr T = k - 1 on the free-slip family. */
+ * sign, the source's own raw (Eq. 5) value Dk: D enters Eq. 9 as P does Eq. 6, so its ghost
+ * mirrors it as the pressure is mirrored. That is T = J (the plane mirror, a corner's double
+ * mirror, the periodic images) and a circle's single curved mirror T = k (I - e e^T) - e e^T,
+ * k = r_g/r_s > 0 (kernels/ghosts.c), J = I - 2 e e^T: det J < 0, T e = -e, tr T = k - 1 > -1,
+ * tested as T (I - J) = -(I - J) with e e^T = (I - J)/2. Elsewhere (no slip T = -I, the open
+ * boundaries' maps) the trace of the mapped gradient (T U) J^T, U the source's renormalised
+ * gradient (row-major). The curved mirror's trace, k U_tt + U_nn, would add (k - 1) U_tt =
+ * O(dx/a) |u - u_w|/a, a damper pressure of order alpha rho0 c0 R |u - u_w| dx/a^2 that pushed a
+ * cylinder moving through still water along its velocity (docs/choices.md "ghost values"). */
 static inline real ghost_div(const real *J, const real *T, const real *U, real Dk) {
+  if (T[0] == J[0] && T[1] == J[1] && T[2] == J[2] && T[3] == J[3])
+    return Dk;
   const real N0 = (1 - J[0]) * (real)0.5, N1 = -J[1] * (real)0.5, N2 = -J[2] * (real)0.5,
              N3 = (1 - J[3]) * (real)0.5;
   const real e0 = T[0] * N0 + T[1] * N2 + N0, e1 = T[0] * N1 + T[1] * N3 + N1;
   const real e2 = T[2] * N0 + T[3] * N2 + N2, e3 = T[2] * N1 + T[3] * N3 + N3;
   const real tol = (real)1e-5;
-  if (T[0] + T[3] > -1 && fabs(e0) < tol && fabs(e1) < tol && fabs(e2) < tol && fabs(e3) < tol)
+  if (J[0] * J[3] - J[1] * J[2] < 0 && T[0] + T[3] > -1 && fabs(e0) < tol && fabs(e1) < tol &&
+      fabs(e2) < tol && fabs(e3) < tol)
     return Dk;
   const real M0 = T[0] * U[0] + T[1] * U[2], M1 = T[0] * U[1] + T[1] * U[3];
   const real M2 = T[2] * U[0] + T[3] * U[2], M3 = T[2] * U[1] + T[3] * U[3];
