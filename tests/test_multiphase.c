@@ -629,6 +629,81 @@ static void test_ghost_maps(void) {
   }
 }
 
+/* The mirrors' hydrostatic continuation (kernels/multiphase/mp.c rhod_mp_fill_state): a
+ * column at rest under gravity between a floor and a lid, x periodic, in the exact Tait
+ * profile (rho/rho0)^(gamma - 1) = 1 + (gamma - 1) g (H - y)/c^2 (P = 0 at the lid). Every
+ * ghost's pressure is the profile's at its own position, and the first rows' acceleration
+ * vanishes as the inner rows' does (with plain copies the floor's rows fell at 0.6 g). */
+static void test_hydrostatic_ghosts(void) {
+  rhod_mp_params q = prm_default();
+  q.nphase = 1;
+  q.ph[0].rho0 = 1000, q.ph[0].c = 20, q.ph[0].gamma = 7;
+  q.delta = 0, q.xi_shift = 0, q.xi_rep = 0; /* the pressure gradient alone */
+  q.gx = 0, q.gy = (real)-9.81;
+  const int nx = 16, ny = 20;
+  const double dx = 0.05, H = ny * dx, g = 9.81, c2 = 400, gm = 7;
+  box bx;
+  memset(&bx, 0, sizeof bx);
+  bx.dx = dx, bx.R = q.ratio * dx;
+  bx.sc = unit_scene(dx);
+  bx.sc->periodic[0] = 1;
+  rhod_wall w;
+  memset(&w, 0, sizeof w);
+  w.shape.kind = RHOD_SHAPE_RECT;
+  w.shape.min[0] = -1, w.shape.max[0] = nx * dx + 1, w.shape.max[1] = H;
+  w.fluid_inside = 1;
+  bx.sc->walls = &w, bx.sc->n_walls = 1;
+  rhod_particles *p = &bx.p;
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(p, (size_t)(nx * ny) + 16), RHOD_OK);
+  CU_ASSERT_EQUAL_FATAL(rhod_particles_add_tags(p), RHOD_OK);
+  size_t n = 0;
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++, n++) {
+      const double y = (j + 0.5) * dx;
+      const double rho = 1000 * pow(1 + (gm - 1) * g * (H - y) / c2, 1 / (gm - 1));
+      p->x[n] = (real)((i + 0.5) * dx), p->y[n] = (real)y;
+      p->ux[n] = p->uy[n] = 0;
+      p->rho[n] = (real)rho, p->m[n] = (real)(rho * dx * dx), p->dx[n] = (real)dx;
+      p->id[n] = n, p->phase[n] = 0;
+    }
+  p->n = n, p->next_id = n;
+  CU_ASSERT_EQUAL_FATAL(rhod_mp_init(&bx.m, &q, p), RHOD_OK);
+  const double lo[2] = {0, 0}, hi[2] = {nx * dx, H};
+  CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&bx.b, bx.sc, lo, hi), RHOD_OK);
+  const double clo[2] = {-2 * bx.R, -2 * bx.R}, chi[2] = {hi[0] + 2 * bx.R, hi[1] + 2 * bx.R};
+  CU_ASSERT_EQUAL_FATAL(rhod_cells_init(&bx.c, clo, chi, bx.R, RHOD_CELL_REACH, p->cap), RHOD_OK);
+  box_rhs(&bx, (real)1e-4);
+  rhod_to_host(p->y, (p->n + p->ng) * sizeof(real));
+  rhod_to_host(bx.m.P, (p->n + p->ng) * sizeof(real));
+  rhod_to_host(bx.m.acc, 2 * p->n * sizeof(real));
+  double perr = 0, aw = 0, ai = 0;
+  int walls = 0;
+  for (size_t gh = p->n; gh < p->n + p->ng; gh++) {
+    if (p->y[gh] > 0 && p->y[gh] < H)
+      continue; /* a periodic image */
+    const double y = p->y[gh];
+    const double Pex = 1000 * c2 / gm * (pow(1 + (gm - 1) * g * (H - y) / c2, gm / (gm - 1)) - 1);
+    perr = fmax(perr, fabs(bx.m.P[gh] - Pex));
+    walls++;
+  }
+  for (size_t i = 0; i < p->n; i++) {
+    const double y = p->y[i], a = hypot(bx.m.acc[2 * i], bx.m.acc[2 * i + 1]);
+    if (y < 2 * dx || y > H - 2 * dx)
+      aw = fmax(aw, a);
+
+    else
+      ai = fmax(ai, a);
+  }
+  printf("\n  %d wall ghosts: largest |P - P_exact| %.3g Pa (rho0 g H %.0f); largest |acc|: first "
+         "two rows at the floor and the lid %.3g, inside %.3g m/s^2\n",
+         walls, perr, 1000 * g * H, aw, ai);
+  CU_ASSERT(walls > 2 * nx);
+  CU_ASSERT(perr < TOL(1e-9, 1e-5) * 1000 * g * H);
+  CU_ASSERT(ai < 0.01 * g);
+  CU_ASSERT(aw < 0.01 * g);
+  box_free(&bx);
+}
+
 int main(void) {
   const rhod_test_case cases[] = {
       {"Tait EOS and its inverse (Eq. 3)", test_eos},
@@ -641,6 +716,7 @@ int main(void) {
       {"repulsive shifting term f_ij (Eq. 6)", test_repulsive_term},
       {"time step limits (001 Eqs. 14-17)", test_dt_limits},
       {"engine ghost maps: scalar, vector, velocity", test_ghost_maps},
+      {"mirrors continue the hydrostatic profile", test_hydrostatic_ghosts},
   };
   return RHOD_RUN_TESTS("multiphase", cases);
 }

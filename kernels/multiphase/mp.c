@@ -122,10 +122,9 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
     nu[i] = T[RHOD_MP_TAB_MU * MAXP + k] / rho[i];
     col[i] = T[RHOD_MP_TAB_COLOUR * MAXP + k];
   }
-  /* ghosts: plain copies of the source's state (no hydrostatic correction), the velocity
-   * through the walls' own conditions (free slip, no slip, periodic images) in every term:
-   * this scheme does not yet split no slip into its viscous term alone (docs/choices.md
-   * "no slip in the viscous term only") */
+  /* ghosts: copies of the source's state, the velocity through the walls' own conditions
+   * (free slip, no slip, periodic images) in every term: this scheme does not yet split no
+   * slip into its viscous term alone (docs/choices.md "no slip in the viscous term only") */
   rhod_ghosts_map_velocity_viscous(p, p->ux, p->uy);
   rhod_ghosts_map_scalar(p, p->rho);
   rhod_ghosts_map_scalar(p, m->P);
@@ -133,6 +132,41 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
   rhod_ghosts_map_scalar(p, m->nu);
   rhod_ghosts_map_scalar(p, m->col);
   rhod_ghosts_map_u8(p, p->phase);
+  /* The density and pressure of a mirror continue the source's hydrostatic profile under
+   * the body force less the acceleration of the wall at the mirror's foot (a moving body's
+   * gA), as RHOD-SPH's ghosts do (docs/choices.md "ghost values", "bodies"): along it
+   * dP = rho a . dx, which the Tait law (paper 000 Eq. 3) integrates exactly to
+   * (rho_g/rho0)^(gamma - 1) = (rho_k/rho0)^(gamma - 1) + (gamma - 1) a . (x_g - x_k) / c^2,
+   * rho_g = rho_k exp(a . (x_g - x_k) / c^2) for gamma = 1. Our choice: paper 000 states
+   * none (its cases have no body force). Skipped where there is neither, so that such a
+   * scene computes exactly what it did; a periodic image has x_g - x_k = 0 (ge). The volume
+   * stays the source's (a mirror keeps areas; m_g/rho_g would make the ghosts of a denser
+   * bottom row smaller than the lattice's cells, and the floor's rows fell at 2.8 % of g). */
+  const real gx = m->prm.gx, gy = m->prm.gy, *gA = p->gA, *ge = p->ge;
+  if (gx == 0 && gy == 0 && !gA)
+    return;
+  const long nt = n + (long)p->ng;
+  real *R = p->rho;
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < nt; g++) {
+    real ax = gx, ay = gy;
+    if (gA)
+      ax -= gA[2 * g], ay -= gA[2 * g + 1];
+    const real a = ax * ge[2 * g] + ay * ge[2 * g + 1];
+    const int k = ph[g];
+    const real r0 = T[RHOD_MP_TAB_RHO0 * MAXP + k], c = T[RHOD_MP_TAB_C * MAXP + k],
+               gam = T[RHOD_MP_TAB_GAMMA * MAXP + k], rk = R[g];
+    real rg;
+    if (gam == 1) {
+      rg = rk * exp(a / (c * c));
+    } else {
+      const real base = pow(rk / r0, gam - 1) + (gam - 1) * a / (c * c);
+      rg = base > 0 ? r0 * pow(base, 1 / (gam - 1)) : rk;
+    }
+    R[g] = rg;
+    P[g] = rhod_mp_eos(r0, c, gam, rg); /* paper 000 Eq. 3 */
+    nu[g] *= rk / rg;                   /* mu / rho; V keeps the source's: a mirror's area */
+  }
 }
 
 /* The rows every gather reads, in the order of the cells' last build (fluid and ghosts). */
