@@ -8,7 +8,7 @@
 
 /* The viscous part (body.h): per ghost of a body, its pair sum over the fluid. */
 static int viscous(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
-                   real ratio, const real *V, real mu) {
+                   real ratio, const real *V, real mu, const real *nu) {
   const long n = (long)p->n, nt = (long)(p->n + p->ng);
   const size_t need = (size_t)(nt - n);
   if (need > bb->fghost_cap) {
@@ -26,6 +26,7 @@ static int viscous(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c
   const rhod_grid G = c->g;
   const int32_t *CS = c->start, *CI = c->idx, *gbody = p->gbody;
   const real *x = p->x, *y = p->y, *ux = p->ux, *uy = p->uy, *gTv = p->gTv, *gUv = p->gUv;
+  const real *rho = p->rho;
   const int32_t *gsrc = p->gsrc;
   real *f = bb->fghost;
   RHOD_GATHER_LOOP
@@ -52,10 +53,12 @@ static int viscous(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c
             const real r = sqrt(r2);
             /* grad_i W_ij = dW/dr (x_i - x_j)/r, with i's radius */
             const real dWr = rhod_dW(kern, r, Ri) / r;
-            /* Bouscasse et al. 2013 (paper 002 Ref. 8), d = 2: -2 (d + 2) mu pi_ij grad_i W_ij
-             * V_i V_j, the reaction of paper 002 Eq. 10's force on i */
+            /* Bouscasse et al. 2013 (paper 002 Ref. 8), d = 2: -2 (d + 2) mu_ij pi_ij
+             * grad_i W_ij V_i V_j, the reaction of paper 002 Eq. 10's force on i; with nu,
+             * mu_ij = rho_i rho_j (nu_i + nu_j) / (rho_i + rho_j) (paper 001 Eq. 6) */
+            const real muij = nu ? rho[i] * rho[g] * (nu[i] + nu[g]) / (rho[i] + rho[g]) : mu;
             const real pij = ((ux[i] - uxj) * rx + (uy[i] - uyj) * ry) / r2;
-            const real a = -8 * mu * pij * dWr * V[i] * Vj;
+            const real a = -8 * muij * pij * dWr * V[i] * Vj;
             fx += a * rx;
             fy += a * ry;
           }
@@ -84,7 +87,7 @@ static int viscous(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c
 }
 
 int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
-                       real ratio, const real *P, const real *V, real mu) {
+                       real ratio, const real *P, const real *V, real mu, const real *nu) {
   for (int k = 0; k < bb->n; k++)
     bb->b[k].F[0] = bb->b[k].F[1] = bb->b[k].F[2] = 0;
   if (bb->n == 0)
@@ -113,7 +116,7 @@ int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cell
     const double rx = bb->px[q] - (B->G0[0] + B->q[0]), ry = bb->py[q] - (B->G0[1] + B->q[1]);
     B->F[0] += fx, B->F[1] += fy, B->F[2] += rx * fy - ry * fx;
   }
-  if (mu > 0 && p->gbody && p->ng > 0)
-    return viscous(bb, p, c, kern, ratio, V, mu);
+  if ((mu > 0 || nu) && p->gbody && p->ng > 0)
+    return viscous(bb, p, c, kern, ratio, V, mu, nu);
   return RHOD_OK;
 }

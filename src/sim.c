@@ -764,7 +764,7 @@ int rhod_sim_step(rhod_sim *s, double dt, char *err, size_t errlen) {
       /* the bodies in lockstep (body.h): free ones take this stage's force, every moving
        * one stands where the next stage is evaluated */
       st = rhod_bodies_forces(&s->bodies, p, &s->cells, s->sc->kernel, (real)s->sc->radius_ratio,
-                              *s->P, *s->V, (real)s->body_mu);
+                              *s->P, *s->V, (real)s->body_mu, s->body_nu ? *s->body_nu : NULL);
       if (st != RHOD_OK)
         goto mem;
       rhod_bodies_stage(&s->bodies, &s->rk.table, stage, s->t, dt, s->sc->gravity);
@@ -948,7 +948,7 @@ void rhod_probe_values(rhod_sim *s, double *values) {
     /* the force on each body at this (prepared) state; without the scratch it needs, NaN
      * (the run's snapshot check does not see probes: the row says what is missing) */
     if (rhod_bodies_forces(&s->bodies, p, &s->cells, sc->kernel, (real)sc->radius_ratio, *s->P,
-                           *s->V, (real)s->body_mu) != RHOD_OK)
+                           *s->V, (real)s->body_mu, s->body_nu ? *s->body_nu : NULL) != RHOD_OK)
       for (int b = 0; b < s->bodies.n; b++)
         s->bodies.b[b].F[0] = s->bodies.b[b].F[1] = s->bodies.b[b].F[2] = NAN;
     rhod_bodies_values(&s->bodies, values + k);

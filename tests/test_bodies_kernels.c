@@ -23,9 +23,11 @@
 #ifdef RHOD_SINGLE
 #define EPS 2e-5
 #define TOLX 1e-6 /* positions: float's digits */
+#define TOLF 1e-5 /* forces summed in float */
 #else
 #define EPS 1e-10
 #define TOLX 1e-12
+#define TOLF 1e-12
 #endif
 
 typedef struct {
@@ -359,7 +361,8 @@ static void test_buoyancy(void) {
   rhod_dev_map(P, nt * sizeof(real));
   rhod_dev_map(V, nt * sizeof(real));
   CU_ASSERT_EQUAL_FATAL(
-      rhod_bodies_forces(&t.bb, p, &t.c, RHOD_KERNEL_WENDLAND_C2, (real)RATIO, P, V, 0), RHOD_OK);
+      rhod_bodies_forces(&t.bb, p, &t.c, RHOD_KERNEL_WENDLAND_C2, (real)RATIO, P, V, 0, NULL),
+      RHOD_OK);
   rhod_dev_unmap(P, nt * sizeof(real));
   rhod_dev_unmap(V, nt * sizeof(real));
   const double *F = t.bb.b[0].F, Fb = RHO * GRAV * 0.04;
@@ -368,6 +371,65 @@ static void test_buoyancy(void) {
   CU_ASSERT(fabs(F[1] / Fb - 1) < 1e-6);
   CU_ASSERT(fabs(F[0]) < 1e-6 * Fb);
   CU_ASSERT(fabs(F[2]) < 1e-6 * Fb * 0.1);
+  unmake(&t);
+}
+
+/* The viscous force with a per-particle kinematic viscosity (a multiphase scheme's; body.h):
+ * the pair coefficient rho_i rho_j (nu_i + nu_j) / (rho_i + rho_j) is mu for one fluid at any
+ * densities, so nu = mu / rho gives the scalar mu's force to round-off, and 2 nu twice it. A
+ * no-slip circle at rest in a shear u = (s (y - y_c), 0), densities scattered by 1 %. */
+static void test_viscous_nu(void) {
+  setup t;
+  init_body(&t, RHOD_SHAPE_CIRCLE);
+  t.noslip_fields = 1;
+  t.body.slip = RHOD_SLIP_NO;
+  static real P[40000], V[40000], nu[40000];
+  make(&t, 0, P, V);
+  rhod_particles *p = &t.p;
+  const size_t nt = p->n + p->ng;
+  CU_ASSERT_FATAL(nt <= 40000);
+  const double mu = 0.7, s = 0.5;
+  unsigned long seed = 7;
+  for (size_t i = 0; i < nt; i++) {
+    seed = seed * 6364136223846793005ul + 1442695040888963407ul;
+    p->rho[i] = (real)(RHO * (1 + 0.01 * ((double)(seed >> 11) / 9007199254740992.0 - 0.5)));
+    if (i < p->n)
+      p->ux[i] = (real)(s * (p->y[i] - 0.405)), p->uy[i] = 0;
+  }
+  rhod_to_device(p->rho, nt * sizeof(real));
+  rhod_to_device(p->ux, nt * sizeof(real));
+  rhod_to_device(p->uy, nt * sizeof(real));
+  rhod_dev_map(P, nt * sizeof(real));
+  rhod_dev_map(V, nt * sizeof(real));
+  rhod_dev_map(nu, nt * sizeof(real));
+  /* runs: the pressure alone, mu, nu = mu / rho, 2 nu; the viscous part is F - F_pressure */
+  double F[4][3];
+  for (int run = 0; run < 4; run++) {
+    for (size_t i = 0; i < nt; i++)
+      nu[i] = (real)((run == 3 ? 2 : 1) * mu / p->rho[i]);
+    rhod_to_device(nu, nt * sizeof(real));
+    CU_ASSERT_EQUAL_FATAL(rhod_bodies_forces(&t.bb, p, &t.c, RHOD_KERNEL_WENDLAND_C2, (real)RATIO,
+                                             P, V, run == 1 ? (real)mu : 0, run > 1 ? nu : NULL),
+                          RHOD_OK);
+    for (int q = 0; q < 3; q++)
+      F[run][q] = t.bb.b[0].F[q];
+  }
+  rhod_dev_unmap(P, nt * sizeof(real));
+  rhod_dev_unmap(V, nt * sizeof(real));
+  rhod_dev_unmap(nu, nt * sizeof(real));
+  double v[3][3];
+  for (int r = 0; r < 3; r++)
+    for (int q = 0; q < 3; q++)
+      v[r][q] = F[r + 1][q] - F[0][q];
+  printf("\n  shear on a circle, viscous part: F = (%.6g, %.6g), Mz %.6g with mu; with nu = mu/rho "
+         "(%.6g, %.6g), %.6g; with 2 nu (%.6g, %.6g), %.6g\n",
+         v[0][0], v[0][1], v[0][2], v[1][0], v[1][1], v[1][2], v[2][0], v[2][1], v[2][2]);
+  const double sc = fabs(v[0][0]) + fabs(v[0][1]) + fabs(v[0][2]);
+  CU_ASSERT(fabs(v[0][2]) > 1e-3); /* the shear turns the circle */
+  for (int q = 0; q < 3; q++) {
+    CU_ASSERT(fabs(v[1][q] - v[0][q]) < TOLF * sc);
+    CU_ASSERT(fabs(v[2][q] - 2 * v[0][q]) < TOLF * sc);
+  }
   unmake(&t);
 }
 
@@ -606,6 +668,7 @@ int main(void) {
       {"moving body kinematics", test_moving_kinematics},
       {"no slip in the viscous map only", test_noslip_maps},
       {"buoyancy from the pressure integral", test_buoyancy},
+      {"viscous force with a per-particle nu", test_viscous_nu},
       {"free motion in lockstep", test_free_motion},
       {"added-mass relaxation: a light body coupled stably", test_added_mass_relaxation},
       {"no cap on segments and mirrors", test_no_cap},

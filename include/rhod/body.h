@@ -95,13 +95,16 @@ void rhod_bodies_stage(rhod_bodies *bb, const rhod_rk_table *tab, int s, double 
  * Pressure: the surface integral F = -oint P n dS, M = -oint (x - x_G) x P n dS over the
  * quadrature points, P there the Shepard interpolation over fluid and ghosts (paper 000
  * Eq. 8; 0 where Gamma < 0.1, a dry point of a body piercing the surface).
- * Viscosity (mu > 0): the viscous part of the pair form of Bouscasse et al. 2013 (paper
- * 002 Ref. 8), central pair forces, F = sum_{j ghost of B} sum_{i fluid} -2 (d + 2) mu pi_ij
- * grad_i W_ij V_i V_j, M = sum (x_j - x_G) x [the same], pi_ij = (u_i - u_j).(x_i - x_j) /
- * |x_i - x_j|^2, W with fluid particle i's radius (ratio dx_i). Our choices: docs/choices.md
+ * Viscosity (mu > 0, or nu given): the viscous part of the pair form of Bouscasse et al.
+ * 2013 (paper 002 Ref. 8), central pair forces, F = sum_{j ghost of B} sum_{i fluid}
+ * -2 (d + 2) mu_ij pi_ij grad_i W_ij V_i V_j, M = sum (x_j - x_G) x [the same],
+ * pi_ij = (u_i - u_j).(x_i - x_j) / |x_i - x_j|^2, W with fluid particle i's radius (ratio
+ * dx_i). mu_ij = mu, or with a per-particle kinematic viscosity nu (fluid and ghosts; a
+ * multiphase scheme's) rho_i rho_j (nu_i + nu_j) / (rho_i + rho_j), the coefficient of
+ * paper 001 Eq. 6 (Szewc et al.), which is mu for one fluid. Our choices: docs/choices.md
  * "bodies: force". RHOD_ERR_MEMORY when the scratch cannot grow. */
 int rhod_bodies_forces(rhod_bodies *bb, const rhod_particles *p, const rhod_cells *c, int kern,
-                       real ratio, const real *P, const real *V, real mu);
+                       real ratio, const real *P, const real *V, real mu, const real *nu);
 
 /* The columns for probes.csv (RHOD_BODY_COLUMNS per body) at the current state. */
 void rhod_bodies_values(const rhod_bodies *bb, double *out);

@@ -45,6 +45,8 @@ typedef struct rhod_sim {
                                    one-fluid scheme's at 0): open boundaries' nominal mass */
   double c0[RHOD_SIM_PHASES];   /* and its speed of sound: the outflows' pressure relaxation */
   double body_mu; /* the dynamic viscosity of the bodies' force (the scheme's; 0 inviscid) */
+  real **body_nu; /* or a per-particle kinematic viscosity over fluid and ghosts (the address
+                     of the scheme's pointer, as P and V; NULL where body_mu serves) */
   unsigned *outline_start; /* the bodies' outlines of the last rhod_sim_fetch */
   double *outline_xy;
   real *vort; /* the vorticity of the last rhod_sim_fetch (a store field, "vort"), where the

@@ -120,6 +120,10 @@ static int mp_init(rhod_sim *s, char *err, size_t errlen) {
   }
   s->P = &m->P;
   s->V = &m->V;
+  /* the bodies' viscous force with each particle's nu (paper 001 Eq. 6's pair coefficient) */
+  for (int k = 0; k < m->prm.nphase; k++)
+    if (m->prm.ph[k].mu > 0)
+      s->body_nu = &m->nu;
   return RHOD_OK;
 }
 
