@@ -44,7 +44,8 @@ static rhod_mp_params prm_default(void) {
 }
 
 /* A periodic box [0, nx dx] x [0, ny dx] holding a square lattice at (i + 1/2) dx, phase 0,
- * at rest, rho = rho0 of phase 0, m = rho dx^2. */
+ * at rest, rho = rho0 of phase 0, m = rho dx^2; with a wall (box_make_wall) periodic in x
+ * only, the wall bounding it in y. */
 typedef struct {
   rhod_particles p;
   rhod_cells c;
@@ -54,11 +55,14 @@ typedef struct {
   double dx, R;
 } box;
 
-static void box_make(box *bx, int nx, int ny, double dx, const rhod_mp_params *prm) {
+static void box_make_wall(box *bx, int nx, int ny, double dx, const rhod_mp_params *prm,
+                          rhod_wall *wall) {
   memset(bx, 0, sizeof *bx);
   bx->dx = dx, bx->R = prm->ratio * dx;
   bx->sc = unit_scene(dx);
-  bx->sc->periodic[0] = bx->sc->periodic[1] = 1;
+  bx->sc->periodic[0] = 1, bx->sc->periodic[1] = wall == NULL;
+  if (wall)
+    bx->sc->walls = wall, bx->sc->n_walls = 1;
   rhod_particles *p = &bx->p;
   CU_ASSERT_EQUAL_FATAL(rhod_particles_init(p, (size_t)(nx * ny) + 16), RHOD_OK);
   CU_ASSERT_EQUAL_FATAL(rhod_particles_add_tags(p), RHOD_OK);
@@ -80,6 +84,10 @@ static void box_make(box *bx, int nx, int ny, double dx, const rhod_mp_params *p
   CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&bx->b, bx->sc, lo, hi), RHOD_OK);
   const double clo[2] = {-2 * bx->R, -2 * bx->R}, chi[2] = {hi[0] + 2 * bx->R, hi[1] + 2 * bx->R};
   CU_ASSERT_EQUAL_FATAL(rhod_cells_init(&bx->c, clo, chi, bx->R, RHOD_CELL_REACH, p->cap), RHOD_OK);
+}
+
+static void box_make(box *bx, int nx, int ny, double dx, const rhod_mp_params *prm) {
+  box_make_wall(bx, nx, ny, dx, prm, NULL);
 }
 
 /* the driver's order: ghosts, cells, state, right-hand side */
@@ -642,36 +650,19 @@ static void test_hydrostatic_ghosts(void) {
   q.gx = 0, q.gy = (real)-9.81;
   const int nx = 16, ny = 20;
   const double dx = 0.05, H = ny * dx, g = 9.81, c2 = 400, gm = 7;
-  box bx;
-  memset(&bx, 0, sizeof bx);
-  bx.dx = dx, bx.R = q.ratio * dx;
-  bx.sc = unit_scene(dx);
-  bx.sc->periodic[0] = 1;
   rhod_wall w;
   memset(&w, 0, sizeof w);
   w.shape.kind = RHOD_SHAPE_RECT;
   w.shape.min[0] = -1, w.shape.max[0] = nx * dx + 1, w.shape.max[1] = H;
   w.fluid_inside = 1;
-  bx.sc->walls = &w, bx.sc->n_walls = 1;
+  box bx;
+  box_make_wall(&bx, nx, ny, dx, &q, &w);
   rhod_particles *p = &bx.p;
-  CU_ASSERT_EQUAL_FATAL(rhod_particles_init(p, (size_t)(nx * ny) + 16), RHOD_OK);
-  CU_ASSERT_EQUAL_FATAL(rhod_particles_add_tags(p), RHOD_OK);
-  size_t n = 0;
-  for (int j = 0; j < ny; j++)
-    for (int i = 0; i < nx; i++, n++) {
-      const double y = (j + 0.5) * dx;
-      const double rho = 1000 * pow(1 + (gm - 1) * g * (H - y) / c2, 1 / (gm - 1));
-      p->x[n] = (real)((i + 0.5) * dx), p->y[n] = (real)y;
-      p->ux[n] = p->uy[n] = 0;
-      p->rho[n] = (real)rho, p->m[n] = (real)(rho * dx * dx), p->dx[n] = (real)dx;
-      p->id[n] = n, p->phase[n] = 0;
-    }
-  p->n = n, p->next_id = n;
-  CU_ASSERT_EQUAL_FATAL(rhod_mp_init(&bx.m, &q, p), RHOD_OK);
-  const double lo[2] = {0, 0}, hi[2] = {nx * dx, H};
-  CU_ASSERT_EQUAL_FATAL(rhod_boundary_init(&bx.b, bx.sc, lo, hi), RHOD_OK);
-  const double clo[2] = {-2 * bx.R, -2 * bx.R}, chi[2] = {hi[0] + 2 * bx.R, hi[1] + 2 * bx.R};
-  CU_ASSERT_EQUAL_FATAL(rhod_cells_init(&bx.c, clo, chi, bx.R, RHOD_CELL_REACH, p->cap), RHOD_OK);
+  for (size_t i = 0; i < p->n; i++) { /* the exact profile on the lattice */
+    const double y = p->y[i];
+    const double rho = 1000 * pow(1 + (gm - 1) * g * (H - y) / c2, 1 / (gm - 1));
+    p->rho[i] = (real)rho, p->m[i] = (real)(rho * dx * dx);
+  }
   box_rhs(&bx, (real)1e-4);
   rhod_to_host(p->y, (p->n + p->ng) * sizeof(real));
   rhod_to_host(bx.m.P, (p->n + p->ng) * sizeof(real));

@@ -98,4 +98,16 @@ void rhod_particles_append(rhod_particles *p, const int32_t *src, size_t count);
  * new slots, an exclusive scan). Ghosts are dropped. Returns the new n, or -1 when out
  * of memory (the scan's) or nflag > n, the store then unchanged. */
 long rhod_particles_compact(rhod_particles *p, int32_t *keep, size_t nflag);
+
+/* The hydrostatic head of ghost g over its source: (g - a_w) . e, (gx, gy) the body force, a_w
+ * the acceleration of a moving body's boundary at the mirror's foot (gA, NULL without bodies)
+ * and e = ge the ghost's displacement from its source (0 for a periodic image). Along a
+ * hydrostatic profile dP = rho (g - a_w) . dx: both schemes continue their sources' state
+ * into the ghosts with it (docs/choices.md "ghost values", "multiphase: ghosts"). Inline, so
+ * that device loops can call it. */
+static inline real rhod_ghost_head(const real *ge, const real *gA, real gx, real gy, long g) {
+  if (gA)
+    gx -= gA[2 * g], gy -= gA[2 * g + 1];
+  return gx * ge[2 * g] + gy * ge[2 * g + 1];
+}
 #endif

@@ -149,10 +149,7 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
   real *R = p->rho;
   RHOD_KERNEL_LOOP
   for (long g = n; g < nt; g++) {
-    real ax = gx, ay = gy;
-    if (gA)
-      ax -= gA[2 * g], ay -= gA[2 * g + 1];
-    const real a = ax * ge[2 * g] + ay * ge[2 * g + 1];
+    const real a = rhod_ghost_head(ge, gA, gx, gy, g);
     const int k = ph[g];
     const real r0 = T[RHOD_MP_TAB_RHO0 * MAXP + k], c = T[RHOD_MP_TAB_C * MAXP + k],
                gam = T[RHOD_MP_TAB_GAMMA * MAXP + k], rk = R[g];

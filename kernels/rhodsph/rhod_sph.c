@@ -165,10 +165,7 @@ void rhod_sph_fill_state(rhod_sph *s, rhod_particles *p) {
     const real Pk = c2 * (rho[k] - rho0);
     /* a moving body's ghost: g - a_w, the acceleration its boundary has at the mirror's
      * foot (docs/choices.md "bodies"); gA is 0 for walls, absent without bodies */
-    real ax = gx, ay = gy;
-    if (gA)
-      ax -= gA[2 * g], ay -= gA[2 * g + 1];
-    const real a = (ax * ge[2 * g] + ay * ge[2 * g + 1]) / c2;
+    const real a = rhod_ghost_head(ge, gA, gx, gy, g) / c2;
     const real Pg = Pk + rho[k] * c2 * expm1(a);
     P[g] = Pg;
     rho[g] = rho0 + Pg / c2;
