@@ -24,6 +24,64 @@ static inline real seg_dist2(const real *S, real x, real y) {
   return ex * ex + ey * ey;
 }
 
+/* The share of face k of a closed outline with the fluid outside (a body, or a wall with
+ * `fluid_inside: false`) in its mirror image at (qx, qy) (docs/choices.md "bodies: ghosts
+ * near convex vertices"). Within R of a vertex a point inside the outline is the image of
+ * fluid in each face f whose mirror reaches it: q behind f's line by e_f < R, its foot on f
+ * (0 <= t_f <= L_f). Each such face takes the share m_f / sum m, m_f = min(R - e_f, t_f,
+ * L_f - t_f, the distance from q to the outline's other faces), the margin by which q stays
+ * inside the region f's mirror reaches: the shares sum to 1 at every point (the inside
+ * within R of the boundary is tiled once, as with the nearest face alone until 2026-12-07)
+ * and each goes to 0 continuously where its mirror ends, so that a ghost fades in and out
+ * as its source passes a vertex's bisector instead of appearing whole. A point outside the
+ * outline (the image of fluid across a thin body or an acute keel) gets 0. Where only face
+ * k reaches q the share is m/m = 1 exactly: a face away from vertices keeps the source's
+ * mass bit for bit. An outline with the fluid inside (a tank) has no convex vertex: 1. */
+static inline real face_share(const real *seg, int k, int first, int count, real qx, real qy,
+                              real R) {
+  /* the two nearest faces' squared distances (a face R or more away caps no margin) */
+  real d1 = R * R, d2 = R * R, area = 0;
+  int i1 = -1, inside = 0;
+  for (int s = first; s < first + count; s++) {
+    const real *S = seg + RHOD_SEG_STRIDE * s;
+    const real e2 = seg_dist2(S, qx, qy);
+    if (e2 < d1)
+      d2 = d1, d1 = e2, i1 = s;
+    else if (e2 < d2)
+      d2 = e2;
+    /* crossing number of the ray from q along +x (the faces close the outline), and twice
+     * the outline's signed area (> 0 counter-clockwise) */
+    const real ax = S[0], ay = S[1], bx = S[0] + S[6] * S[4], by = S[1] + S[6] * S[5];
+    if ((ay > qy) != (by > qy) && qx < ax + (qy - ay) * (bx - ax) / (by - ay))
+      inside = !inside;
+    area += ax * by - bx * ay;
+  }
+  /* the fluid is inside where the first face's normal is its left one on a counter-clockwise
+   * outline (boundary.c push_polygon) */
+  const real *F = seg + RHOD_SEG_STRIDE * first;
+  if ((F[3] * F[4] - F[2] * F[5] > 0) == (area > 0))
+    return 1;
+  if (!inside)
+    return 0;
+  real mk = 0, sum = 0;
+  for (int s = first; s < first + count; s++) {
+    const real *S = seg + RHOD_SEG_STRIDE * s;
+    const real rx = qx - S[0], ry = qy - S[1];
+    const real e = -(S[2] * rx + S[3] * ry), t = S[4] * rx + S[5] * ry;
+    if (!(e > 0 && e < R && t >= 0 && t <= S[6]))
+      continue;
+    real m = R - e;
+    m = t < m ? t : m;
+    m = S[6] - t < m ? S[6] - t : m;
+    const real o = sqrt(s == i1 ? d2 : d1);
+    m = o < m ? o : m;
+    sum += m;
+    if (s == k)
+      mk = m;
+  }
+  return mk > 0 ? mk / sum : 0;
+}
+
 /* A body's boundary velocity at (fx, fy) from its kinematics K (RHOD_KIN_STRIDE):
  * u_w = U + Omega x r, r = f - G (scalars, not a local array: offload_frames). */
 static inline real body_uwx(const real *K, real fx, real fy) {
@@ -147,24 +205,17 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
       continue;
     const real qx = x - 2 * d * S[2], qy = y - 2 * d * S[3];
     const int body = (int)S[10];
-    if (body >= 0) {
-      /* our choice (docs/choices.md "bodies"): the ghost belongs to the nearest face of
-       * its body, so that the images of two faces never overlap at a convex vertex */
-      const int first = (int)S[11], count = (int)S[12];
-      const real lo = d * d * (1 - 2 * RHOD_SUPPORT_TIE), hi = d * d * (1 + 2 * RHOD_SUPPORT_TIE);
-      int other = 0;
-      for (int s2 = first; s2 < first + count && !other; s2++) {
-        /* a tie (the bisector of a corner) goes to the lower segment index */
-        const real e2 = seg_dist2(seg + RHOD_SEG_STRIDE * s2, qx, qy);
-        other = s2 != s && (e2 < lo || (e2 <= hi && s2 < s));
-      }
-      if (other)
-        continue;
-    }
+    /* our choice (docs/choices.md "bodies: ghosts near convex vertices"): the faces of a
+     * body or obstacle share its inside near a convex vertex, so that their images neither
+     * overlap nor appear whole when a source crosses the vertex's bisector */
+    const real share =
+        S[7] < RHOD_SEG_INFLOW ? face_share(seg, s, (int)S[11], (int)S[12], qx, qy, R) : (real)1;
+    if (!(share > 0))
+      continue;
     if (gx) {
       gx[n] = qx;
       gy[n] = qy;
-      M[n] = ms;
+      M[n] = ms * share;
       real *Jn = J + 4 * n, *Tn = T + 4 * n, *Un = U + 2 * n;
       Jn[0] = 1 - 2 * S[2] * S[2];
       Jn[1] = -2 * S[2] * S[3];

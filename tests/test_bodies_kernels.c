@@ -183,6 +183,44 @@ static void test_convex_corner(void) {
   unmake(&t);
 }
 
+/* A ghost fades at a convex vertex (docs/choices.md "bodies: ghosts near convex vertices"):
+ * one particle 0.3 dx above the square's top face moves towards and past its corner; the
+ * mass of its images falls from the source's (more than R from the corner) to 0 (past it)
+ * continuously, by its share of the inside near the vertex. The nearest face's rule dropped the
+ * image whole where the particle crossed the preimage of the vertex's bisector, 0.3 dx before the
+ * corner. */
+static void test_vertex_fade(void) {
+  setup t;
+  init_body(&t, RHOD_SHAPE_RECT);
+  make(&t, 0, NULL, NULL);
+  rhod_particles *p = &t.p;
+  const int N = 2000;
+  const double x0 = 0.5 - (RATIO + 0.5) * DX, span = (RATIO + 1) * DX; /* from R off the corner */
+  double prev = NAN, jump = 0, first = NAN, last = NAN;
+  for (int k = 0; k <= N; k++) {
+    p->n = 1;
+    p->x[0] = (real)(x0 + span * k / N), p->y[0] = (real)(0.5 + 0.3 * DX);
+    p->m[0] = (real)(RHO * DX * DX), p->dx[0] = (real)DX;
+    rhod_particles_to_device(p);
+    CU_ASSERT_EQUAL_FATAL(rhod_ghosts_build(&t.b, p, (real)RATIO, (real)(RATIO * DX)), RHOD_OK);
+    rhod_to_host(p->m, (p->n + p->ng) * sizeof(real));
+    double mg = 0;
+    for (size_t g = p->n; g < p->n + p->ng; g++)
+      mg += p->m[g] / (RHO * DX * DX);
+    if (k > 0)
+      jump = fmax(jump, fabs(mg - prev));
+    if (k == 0)
+      first = mg;
+    prev = last = mg;
+  }
+  printf("\n  vertex fade: image mass %.3f -> %.3f of the source's, largest jump between samples "
+         "%.2g dx apart %.3g\n",
+         first, last, span / DX / N, jump);
+  CU_ASSERT(fabs(first - 1) < EPS && last == 0);
+  CU_ASSERT(jump < 0.02);
+  unmake(&t);
+}
+
 /* A circle of radius a = 12.5 dx: its mirrors fill the ring [a - R, a] inside it with the
  * images of the fluid ring [a, a + R], whose area is (2a + R)/(2a - R) = 1.38 times larger.
  * With m r_g / r_s each image carries the area ratio of the radial mirror, so the ghosts'
@@ -664,6 +702,7 @@ static void test_guard_moving(void) {
 int main(void) {
   static const rhod_test_case cases[] = {
       {"convex corner tiled once", test_convex_corner},
+      {"a ghost fades at a convex vertex", test_vertex_fade},
       {"circle mirrors carry the area ratio", test_circle_mass},
       {"moving body kinematics", test_moving_kinematics},
       {"no slip in the viscous map only", test_noslip_maps},

@@ -78,7 +78,15 @@ int rhod_mp_init(rhod_mp *m, const rhod_mp_params *prm, rhod_particles *p) {
   F(V, 1);
   F(nu, 1);
   F(col, 1);
-  F(pk, m->surface ? RHOD_MP_PK_ROWS : RHOD_MP_PK_ROWS_PLAIN);
+  /* a scene with a no-slip wall or body splits the ghosts' velocity: the free-slip map in
+   * every term but the viscous one, which reads two more rows (uvr) */
+  const long base = m->surface ? RHOD_MP_PK_ROWS : RHOD_MP_PK_ROWS_PLAIN;
+  m->uvr = p->gTv ? base : RHOD_MP_PK_UX;
+  F(pk, p->gTv ? base + 2 : base);
+  if (p->gTv) {
+    F(uvx, 1);
+    F(uvy, 1);
+  }
   F(us, 2);
   F(drho, 1);
   F(acc, 2);
@@ -122,13 +130,31 @@ void rhod_mp_fill_state(rhod_mp *m, rhod_particles *p) {
     nu[i] = T[RHOD_MP_TAB_MU * MAXP + k] / rho[i];
     col[i] = T[RHOD_MP_TAB_COLOUR * MAXP + k];
   }
-  /* ghosts: copies of the source's state, the velocity through the walls' own conditions
-   * (free slip, no slip, periodic images) in every term: this scheme does not yet split no
-   * slip into its viscous term alone (docs/choices.md "no slip in the viscous term only") */
-  rhod_ghosts_map_velocity_viscous(p, p->ux, p->uy);
+  /* ghosts: copies of the source's state. The velocity: the free-slip map (gT) in every
+   * term, and where a wall or body is no slip, that condition's map (gTv) in the viscous
+   * term alone (docs/choices.md "no slip in the viscous term only"). Until 2026-12-07 the
+   * no-slip map entered every term here, the mirrors' reversed tangential velocity a
+   * spurious divergence in Eq. 1 along every no-slip wall (the lid-driven cavity at
+   * L/dx = 50: rms error of u against Ghia 1.11 % of U then, 0.21 % now). */
+  if (m->uvx) {
+    real *ux = p->ux, *uy = p->uy, *vx = m->uvx, *vy = m->uvy;
+    RHOD_KERNEL_LOOP
+    for (long i = 0; i < n; i++)
+      vx[i] = ux[i], vy[i] = uy[i];
+    rhod_ghosts_map_velocity_viscous(p, vx, vy);
+  }
+  rhod_ghosts_map_velocity(p, p->ux, p->uy);
   rhod_ghosts_map_scalar(p, p->rho);
   rhod_ghosts_map_scalar(p, m->P);
-  rhod_ghosts_map_scalar(p, m->V);
+  /* a ghost's volume is its own mass over the source's density: a circle's mirror carries
+   * m_s r_g/r_s, the area ratio of the radial mirror (docs/choices.md "bodies"); elsewhere
+   * m_g = m_s and this is the source's V bit for bit. Until 2026-12-07 V was the source's
+   * there too, over-weighting the ghosts inside a circle by r_s/r_g (up to 9 at a/R = 5/4),
+   * and the transport velocity (Eq. 7) next to it went unstable within 150 steps. */
+  const long ntot = n + (long)p->ng;
+  RHOD_KERNEL_LOOP
+  for (long g = n; g < ntot; g++)
+    V[g] = mass[g] / rho[g];
   rhod_ghosts_map_scalar(p, m->nu);
   rhod_ghosts_map_scalar(p, m->col);
   rhod_ghosts_map_u8(p, p->phase);
@@ -181,6 +207,10 @@ void rhod_mp_pack(rhod_mp *m, const rhod_particles *p, const rhod_cells *c) {
   rhod_cells_pack(c, nt, pk + RHOD_MP_PK_NU * st, m->nu, 1, 0);
   rhod_cells_pack_u8(c, nt, pk + RHOD_MP_PK_PH * st, p->phase);
   rhod_cells_pack(c, nt, pk + RHOD_MP_PK_COL * st, m->col, 1, 0);
+  if (m->uvx) {
+    rhod_cells_pack(c, nt, pk + m->uvr * st, m->uvx, 1, 0);
+    rhod_cells_pack(c, nt, pk + (m->uvr + 1) * st, m->uvy, 1, 0);
+  }
 }
 
 /* Pass 1 (only with surface tension): the colour gradient of Adami et al. with the
@@ -278,11 +308,12 @@ void rhod_mp_pass_colour(rhod_mp *m, rhod_particles *p, const rhod_cells *c) {
       const real *T, const real *pk, const uint8_t *ph, const real *gC, const real *nrm,           \
       const real *sig, real *kap, real *drho, real *acc, real *vel, real *us, int tensile,         \
       int surface, real ratio, real hfac, real delta, real eta2, real xi_shift, real xi_rep,       \
-      real rep_n, real xi_rif, real gxb, real gyb, real alpha, real visc, long nxr, long nyr
+      real rep_n, real xi_rif, real gxb, real gyb, real alpha, real visc, long nxr, long nyr,      \
+      long uvr
 #define MAIN_ARGS                                                                                  \
   G, CS, st, x, y, dx, rho, ux, uy, P, nu, T, pk, ph, gC, nrm, sig, kap, drho, acc, vel, us,       \
       tensile, surface, ratio, hfac, delta, eta2, xi_shift, xi_rep, rep_n, xi_rif, gxb, gyb,       \
-      alpha, visc, nxr, nyr
+      alpha, visc, nxr, nyr, uvr
 
 /* The main pass's gather of particle i; kern and rep2 (the repulsive term's n = 2) are
  * constants in the host build's specialised copies, so that the lanes vectorise. */
@@ -292,7 +323,7 @@ PARTICLE_BODY void main_particle(long i, MAIN_PARAMS, real dt, const int kern, c
              *kux = pk + RHOD_MP_PK_UX * st, *kuy = pk + RHOD_MP_PK_UY * st,
              *krho = pk + RHOD_MP_PK_RHO * st, *km = pk + RHOD_MP_PK_M * st,
              *knu = pk + RHOD_MP_PK_NU * st, *kph = pk + RHOD_MP_PK_PH * st, *knx = pk + nxr * st,
-             *kny = pk + nyr * st;
+             *kny = pk + nyr * st, *kvx = pk + uvr * st, *kvy = pk + (uvr + 1) * st;
   const real xi = x[i], yi = y[i], Ri = ratio * dx[i], iR = 1 / Ri, R2 = Ri * Ri;
   const real iR2 = iR * iR, iR3 = iR2 * iR;
   const real h = hfac * Ri, eta2h = eta2 * h * h;
@@ -327,8 +358,9 @@ PARTICLE_BODY void main_particle(long i, MAIN_PARAMS, real dt, const int kern, c
       RHOD_LANE(s_apx) += pc * gwx;
       RHOD_LANE(s_apy) += pc * gwy;
       /* paper 001 Eq. 6, all phases */
-      const real vc = visc * rhod_mp_visc_coef(km[k], nui, knu[k], rhoi, rhoj,
-                                               uijx * rx + uijy * ry, r2, eta2h);
+      const real vc =
+          visc * rhod_mp_visc_coef(km[k], nui, knu[k], rhoi, rhoj,
+                                   (uxi - kvx[k]) * rx + (uyi - kvy[k]) * ry, r2, eta2h);
       RHOD_LANE(s_avx) += vc * gwx;
       RHOD_LANE(s_avy) += vc * gwy;
       /* paper 001 Eq. 10 over the neighbours with a reliable normal */
@@ -400,6 +432,7 @@ void rhod_mp_pass_main(rhod_mp *m, rhod_particles *p, const rhod_cells *c, real 
    * row will do: every use is multiplied by reli = 0) */
   const long nxr = surface ? RHOD_MP_PK_NX : RHOD_MP_PK_X,
              nyr = surface ? RHOD_MP_PK_NY : RHOD_MP_PK_X;
+  const long uvr = m->uvr; /* RHOD_MP_PK_UX (the same velocity) without no slip */
   const int rep2 = rep_n == 2;
   (void)rep2;
 #ifdef RHOD_OFFLOAD

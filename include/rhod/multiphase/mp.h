@@ -100,6 +100,10 @@ typedef struct {
   real *kap;              /* curvature (001 Eq. 10), 0 where the normal is unreliable */
   real *us;               /* shifting velocity u_s (paper 000 Eq. 7), 2 */
   real *nu, *col;         /* kinematic viscosity and colour (fluid and ghosts) */
+  real *uvx, *uvy;        /* with a no-slip wall or body (p->gTv): the velocity the viscous
+                             term reads, the ghosts' through the walls' own conditions
+                             (docs/choices.md "no slip in the viscous term only") */
+  long uvr;               /* the pk row of uvx (uvy the next), RHOD_MP_PK_UX without them */
   real *pk;               /* neighbour-side rows in cell order (RHOD_MP_PK_*) */
   real *drho, *acc, *vel; /* d rho/dt (1), du/dt (2), dx/dt = u + u_s (2) */
 } rhod_mp;

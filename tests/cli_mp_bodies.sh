@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The multiphase scheme beside obstacles at rest (tests/scenes/run/mp_bodies_rest.yaml): the
+# run reaches its end and its last snapshot has every particle outside the two bodies and
+# the obstacle wall (the distance to the nearest is printed).
+set -uo pipefail
+RHOD=$1; SRC=$2
+# shellcheck source=lib_cli.sh
+source "$(dirname "$0")/lib_cli.sh"
+expect 0 "multiphase run beside two bodies and an obstacle wall at rest" -- \
+  "$RHOD" run "$SRC/tests/scenes/run/mp_bodies_rest.yaml" -o "$T/run"
+check "every particle outside the obstacles" -- /usr/bin/python3 - "$T/run" "$SRC" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[2] + "/tools")
+import numpy as np
+import rhodout
+d = rhodout.read_snapshot(rhodout.snapshots(sys.argv[1])[-1])
+x, y = d["pos"][:, 0], d["pos"][:, 1]
+def square(x0, y0, x1, y1):
+    """signed distance from [x0, x1] x [y0, y1] (negative inside)"""
+    ox = np.maximum(np.maximum(x0 - x, x - x1), 0)
+    oy = np.maximum(np.maximum(y0 - y, y - y1), 0)
+    ins = (x > x0) & (x < x1) & (y > y0) & (y < y1)
+    depth = np.minimum(np.minimum(x - x0, x1 - x), np.minimum(y - y0, y1 - y))
+    return np.where(ins, -depth, np.hypot(ox, oy))
+dsq = square(0.15, 0.54, 0.35, 0.74)
+dwall = square(0.54, 0.74, 0.74, 0.94)
+dcy = np.hypot(x - 0.7, y - 0.4) - 0.1
+near = min(dsq.min(), dcy.min(), dwall.min()) / 0.02
+print(f"  {len(x)} particles; nearest to an obstacle {near:.3f} dx")
+sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from an obstacle")
+PY
+summary mp_bodies
