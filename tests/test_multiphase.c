@@ -701,7 +701,7 @@ static void test_hydrostatic_ghosts(void) {
  * lid, x periodic, with u = (U sin kx, 0). The continuity equation (Eq. 1) must see the
  * mirrors' free-slip velocity, which continues u_x across the wall: the first rows' d rho/dt
  * is then the inner rows' (-rho U k cos kx, to the lattice's accuracy). With the no-slip
- * map -u in every term it is about twice that at the wall, as it was until 2026-12-07.
+ * map -u in every term, as until 2026-12-07, the first rows' is off by 0.58 rho U k.
  * The viscous term sees the no-slip mirrors: the first rows are braked far harder than the
  * inner rows (a free-slip mirror there would brake them as little). */
 static void test_noslip_viscous_only(void) {
