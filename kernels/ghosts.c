@@ -24,8 +24,8 @@ static inline real seg_dist2(const real *S, real x, real y) {
   return ex * ex + ey * ey;
 }
 
-/* The share of face k of a closed outline with the fluid outside (a body, or a wall with
- * `fluid_inside: false`) in its mirror image at (qx, qy) (docs/choices.md "bodies: ghosts
+/* The share of face k of a body's closed outline (S[14]; the fluid outside) in its mirror
+ * image at (qx, qy) (docs/choices.md "bodies: ghosts
  * near convex vertices"). Within R of a vertex a point inside the outline is the image of
  * fluid in each face f whose mirror reaches it: q behind f's line by e_f < R, its foot on f
  * (0 <= t_f <= L_f). Each such face takes the share m_f / sum m, m_f = min(R - e_f, t_f,
@@ -36,11 +36,13 @@ static inline real seg_dist2(const real *S, real x, real y) {
  * as its source passes a vertex's bisector instead of appearing whole. A point outside the
  * outline (the image of fluid across a thin body or an acute keel) gets 0. Where only face
  * k reaches q the share is m/m = 1 exactly: a face away from vertices keeps the source's
- * mass bit for bit. An outline with the fluid inside (a tank) has no convex vertex: 1. */
+ * mass bit for bit. Walls are not asked: a wall with the fluid outside next to an open
+ * boundary would count faces whose preimage lies beyond it, where there is no fluid
+ * (test_open's channel lost its exact outflow balance), so its mirrors stay whole. */
 static inline real face_share(const real *seg, int k, int first, int count, real qx, real qy,
                               real R) {
   /* the two nearest faces' squared distances (a face R or more away caps no margin) */
-  real d1 = R * R, d2 = R * R, area = 0;
+  real d1 = R * R, d2 = R * R;
   int i1 = -1, inside = 0;
   for (int s = first; s < first + count; s++) {
     const real *S = seg + RHOD_SEG_STRIDE * s;
@@ -49,18 +51,11 @@ static inline real face_share(const real *seg, int k, int first, int count, real
       d2 = d1, d1 = e2, i1 = s;
     else if (e2 < d2)
       d2 = e2;
-    /* crossing number of the ray from q along +x (the faces close the outline), and twice
-     * the outline's signed area (> 0 counter-clockwise) */
+    /* crossing number of the ray from q along +x (the faces close the outline) */
     const real ax = S[0], ay = S[1], bx = S[0] + S[6] * S[4], by = S[1] + S[6] * S[5];
     if ((ay > qy) != (by > qy) && qx < ax + (qy - ay) * (bx - ax) / (by - ay))
       inside = !inside;
-    area += ax * by - bx * ay;
   }
-  /* the fluid is inside where the first face's normal is its left one on a counter-clockwise
-   * outline (boundary.c push_polygon) */
-  const real *F = seg + RHOD_SEG_STRIDE * first;
-  if ((F[3] * F[4] - F[2] * F[5] > 0) == (area > 0))
-    return 1;
   if (!inside)
     return 0;
   real mk = 0, sum = 0;
@@ -206,10 +201,9 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     const real qx = x - 2 * d * S[2], qy = y - 2 * d * S[3];
     const int body = (int)S[10];
     /* our choice (docs/choices.md "bodies: ghosts near convex vertices"): the faces of a
-     * body or obstacle share its inside near a convex vertex, so that their images neither
-     * overlap nor appear whole when a source crosses the vertex's bisector */
-    const real share =
-        S[7] < RHOD_SEG_INFLOW ? face_share(seg, s, (int)S[11], (int)S[12], qx, qy, R) : (real)1;
+     * body share its inside near a convex vertex, so that their images neither overlap nor
+     * appear whole when a source crosses the vertex's bisector */
+    const real share = S[14] != 0 ? face_share(seg, s, (int)S[11], (int)S[12], qx, qy, R) : (real)1;
     if (!(share > 0))
       continue;
     if (gx) {

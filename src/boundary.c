@@ -41,6 +41,7 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
     S[9] = moves ? (real)vel[1] : 0;
     S[10] = (real)body;
     S[13] = (real)refine;
+    S[14] = body >= 0; /* shares at convex vertices: bodies only (ghosts.c face_share) */
     (*nseg)++;
   }
   /* corners: edge k ends where edge k+1 starts; the fluid wedge there is narrower
@@ -130,7 +131,7 @@ static int push_open(rhod_boundary *b, const rhod_scene *sc) {
     S[7] = O->kind == RHOD_OPEN_INFLOW ? RHOD_SEG_INFLOW : RHOD_SEG_OUTFLOW;
     S[8] = 0, S[9] = 0, S[10] = -1;
     S[11] = (real)nmark, S[12] = (real)count;
-    S[13] = 0;
+    S[13] = 0, S[14] = 0;
     nmark += count;
   }
   b->nseg += (int)sc->n_open;

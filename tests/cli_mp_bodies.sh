@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
-# The multiphase scheme beside obstacles at rest (tests/scenes/run/mp_bodies_rest.yaml): the
-# run reaches its end and its last snapshot has every particle outside the two bodies and
-# the obstacle wall (the distance to the nearest is printed).
+# The multiphase scheme beside bodies at rest (tests/scenes/run/mp_bodies_rest.yaml): the
+# run reaches its end and its last snapshot has every particle outside both bodies (the
+# distance to the nearer is printed).
 set -uo pipefail
 RHOD=$1; SRC=$2
 # shellcheck source=lib_cli.sh
 source "$(dirname "$0")/lib_cli.sh"
-expect 0 "multiphase run beside two bodies and an obstacle wall at rest" -- \
+expect 0 "multiphase run beside two bodies at rest" -- \
   "$RHOD" run "$SRC/tests/scenes/run/mp_bodies_rest.yaml" -o "$T/run"
-check "every particle outside the obstacles" -- /usr/bin/python3 - "$T/run" "$SRC" <<'PY'
+check "every particle outside the bodies" -- /usr/bin/python3 - "$T/run" "$SRC" <<'PY'
 import sys
 sys.path.insert(0, sys.argv[2] + "/tools")
 import numpy as np
@@ -23,10 +23,9 @@ def square(x0, y0, x1, y1):
     depth = np.minimum(np.minimum(x - x0, x1 - x), np.minimum(y - y0, y1 - y))
     return np.where(ins, -depth, np.hypot(ox, oy))
 dsq = square(0.15, 0.54, 0.35, 0.74)
-dwall = square(0.54, 0.74, 0.74, 0.94)
 dcy = np.hypot(x - 0.7, y - 0.4) - 0.1
-near = min(dsq.min(), dcy.min(), dwall.min()) / 0.02
-print(f"  {len(x)} particles; nearest to an obstacle {near:.3f} dx")
-sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from an obstacle")
+near = min(dsq.min(), dcy.min()) / 0.02
+print(f"  {len(x)} particles; nearest to a body {near:.3f} dx")
+sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from a body")
 PY
 summary mp_bodies
