@@ -1110,7 +1110,7 @@ static void coalesce_groups(rhod_pattern pattern) {
   const int N = rhod_pattern_children(pattern);
   const double dx = 0.01, eps = rhod_pattern_ratio(pattern), h = dx / eps, c0 = 20, rho0 = 1000;
   rhod_scene *sc = unit_scene(dx);
-  sc->rs->refine_coalesce = 1;
+  sc->rs->refine_coalesce = sc->rs->refine_absorb = 1;
   sc->rs->pattern = pattern;
   rhod_particles p;
   CU_ASSERT_EQUAL_FATAL(rhod_particles_init(&p, 800), RHOD_OK);
@@ -1313,14 +1313,17 @@ static long count_fine(const rhod_snapshot_view *v, double dx) {
  * for it: with coalescing the block merges back from its edges (the merged particle
  * needs coarse neighbours, criterion 2 with margin), no merged particle is split
  * again, and mass stays. Without coalescing nothing changes. With criterion 3 the
- * free-surface band made at t = 0 stays (hysteresis). */
+ * free-surface band made at t = 0 stays (hysteresis). With refinement.absorb: false the
+ * stragglers the groups leave stay fine. */
 static void test_coalesce_run(void) {
-  const char *kinds[3] = {
+  const char *kinds[4] = {
       REST_TANK("  coalesce: true\n"
                 "  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n"),
       REST_TANK("  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n"),
-      REST_TANK("  coalesce: true\n  free_surface: true\n")};
-  for (int k = 0; k < 3; k++) {
+      REST_TANK("  coalesce: true\n  free_surface: true\n"),
+      REST_TANK("  coalesce: true\n  absorb: false\n"
+                "  regions: [{rect: {min: [0.1, 0.02], max: [0.2, 0.08]}, level: 1}]\n")};
+  for (int k = 0; k < 4; k++) {
     run r;
     char tag[32];
     snprintf(tag, sizeof tag, "rest%d", k);
@@ -1355,6 +1358,11 @@ static void test_coalesce_run(void) {
        * absorption 240 -> 24 */
       CU_ASSERT(fine < fine0 / 10);
       CU_ASSERT(rhod_rs(r.sim)->apr.absorbed_total > 0);
+    } else if (k == 3) {
+      /* the same groups, no absorption: 240 -> 24 */
+      CU_ASSERT(fine > fine0 / 20 && fine < fine0 / 5);
+      CU_ASSERT(rhod_rs(r.sim)->apr.merged_total > 0);
+      CU_ASSERT_EQUAL(rhod_rs(r.sim)->apr.absorbed_total, 0);
     } else {
       CU_ASSERT_EQUAL(fine, fine0);
     }

@@ -319,6 +319,7 @@ static const struct {
     {"refine_free_surface_no_detection.yaml", 14, "refinement.free_surface",
      "needs the free-surface detection"},
     {"refine_coalesce_static.yaml", 13, "refinement.coalesce", "needs dynamic refinement"},
+    {"refine_absorb_no_coalesce.yaml", 12, "refinement.absorb", "needs refinement.coalesce"},
     {"refine_surface_band_range.yaml", 13, "refinement.surface_band", "must be in [0.5, 1]"},
     {"refine_surface_band_triangle.yaml", 14, "refinement.surface_band", "must be in [0.5774, 1]"},
     {"refine_surface_band_no_criterion.yaml", 12, "refinement.surface_band", "needs criterion 3"},

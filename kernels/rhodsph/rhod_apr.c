@@ -122,6 +122,7 @@ int rhod_apr_init(rhod_apr *a, const rhod_scene *sc, double dx_min) {
   a->eps = (real)rhod_pattern_ratio(sc->rs->pattern);
   a->ieps = (real)(1 / rhod_pattern_ratio(sc->rs->pattern));
   a->coalesce = sc->rs->refine_coalesce;
+  a->absorb = sc->rs->refine_absorb;
   a->dx_max = (real)sc->dx;
   /* the held regions, as flat records on the device (apr.h) */
   const rhod_rs_scene *rs = sc->rs;
@@ -497,7 +498,7 @@ int rhod_apr_mark(rhod_apr *a, const rhod_sph *s, const rhod_particles *p, const
   }
   const long kept = ncand > 0 ? coalesce_c2(a, s, p, c) : 0;
   a->groups = kept >= a->nsplit ? group(a, p, c) : 0;
-  a->absorbed = kept > a->groups * a->nsplit ? absorb(a, s, p, c) : 0;
+  a->absorbed = a->absorb && kept > a->groups * a->nsplit ? absorb(a, s, p, c) : 0;
   if (ncand > 0)
     drop_candidates(mark, n); /* the candidates left over */
   return RHOD_OK;

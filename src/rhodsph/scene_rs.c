@@ -70,6 +70,7 @@ const cyaml_schema_field_t rhod_rs_f_refinement[] = {
     RHOD_RS_NUM_("crowding", y_rs_refinement, crowding),
     RHOD_RS_BOOL_("walls", y_rs_refinement, walls),
     RHOD_RS_BOOL_("coalesce", y_rs_refinement, coalesce),
+    RHOD_RS_BOOL_("absorb", y_rs_refinement, absorb),
     CYAML_FIELD_MAPPING_PTR("field", RHOD_RS_OPT_ | CYAML_FLAG_FLOW, y_rs_refinement, field,
                             f_refine_field),
     CYAML_FIELD_END,
@@ -240,6 +241,11 @@ int rhod_rs_load_refinement(lctx *c, const y_rs_refinement *r, rhod_scene *s) {
                         rs->refine_crowding);
   rs->refine_walls = opt_bool(r ? r->walls : NULL, 0);
   rs->refine_coalesce = opt_bool(r ? r->coalesce : NULL, 0);
+  rs->refine_absorb = rs->refine_coalesce && opt_bool(r ? r->absorb : NULL, 1);
+  if (r && r->absorb && !rs->refine_coalesce)
+    return rhod_sl_fail(c, "refinement.absorb",
+                        "needs refinement.coalesce: true (it is the coalescing's absorption of "
+                        "stragglers)");
   if (r && r->n_regions && rs->pattern != RHOD_PATTERN_SQUARE)
     return rhod_sl_fail(c, "refinement.regions",
                         "need refinement.pattern: square (initial levels are nested lattices, "
@@ -400,6 +406,8 @@ void rhod_rs_tree_refinement(rhod_sl_tb *t, ry_node *root, const rhod_rs_scene *
   rhod_sl_num(t, m, "crowding", rs->refine_crowding);
   rhod_sl_bool(t, m, "walls", rs->refine_walls);
   rhod_sl_bool(t, m, "coalesce", rs->refine_coalesce);
+  if (rs->refine_coalesce)
+    rhod_sl_bool(t, m, "absorb", rs->refine_absorb);
   if (rs->refine_field) {
     e = rhod_sl_coll(t, m, "field", RY_MAP, 1);
     rhod_sl_word(t, e, "quantity",

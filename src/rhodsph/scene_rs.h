@@ -65,7 +65,7 @@ typedef struct {
   double *levels;
   y_rs_region *regions;
   unsigned n_regions;
-  bool *dynamic, *free_surface, *walls, *coalesce;
+  bool *dynamic, *free_surface, *walls, *coalesce, *absorb;
   double *surface_band, *crowding;
   int *pattern;
   y_rs_refine_field *field;

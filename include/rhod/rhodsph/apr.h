@@ -37,6 +37,7 @@ typedef struct {
   int nsplit;     /* children per split: 4 (square pattern) or 3 (triangle) */
   real eps, ieps; /* size ratio of adjacent levels (2 or sqrt 3) and its inverse */
   int coalesce;   /* refinement.coalesce */
+  int absorb;     /* refinement.absorb: stragglers absorbed (absorb in rhod_apr.c) */
   real dx_max;    /* no particle grows beyond this size (particles.dx) */
   /* the held regions (refinement.regions.N.hold, ours): a particle whose centre is in
    * one splits down to its level during the run; none coarser is merged within one

@@ -131,6 +131,8 @@ typedef struct rhod_rs_scene {
   int refine_field;        /* refinement.field given: criterion 5 */
   int refine_coalesce;     /* refinement.coalesce: merge back where no criterion
                               holds any more, default false */
+  int refine_absorb;       /* refinement.absorb: coalescing shares stragglers out among
+                              their coarser neighbours, default true (with coalesce) */
   rhod_quantity field_quantity;    /* refinement.field.quantity */
   double field_above, field_below; /* thresholds (+-HUGE_VAL when absent) */
   double field_from;               /* refinement.field.from [s], default 0 */
