@@ -53,7 +53,7 @@ static inline real face_share(const real *seg, int k, int first, int count, real
       d2 = e2;
     /* crossing number of the ray from q along +x (the faces close the outline) */
     const real ax = S[0], ay = S[1], bx = S[0] + S[6] * S[4], by = S[1] + S[6] * S[5];
-    if ((ay > qy) != (by > qy) && qx < ax + (qy - ay) * (bx - ax) / (by - ay))
+    if (RHOD_RAY_CROSSES(ax, ay, bx, by, qx, qy))
       inside = !inside;
   }
   if (!inside)
@@ -701,7 +701,7 @@ long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *b
       for (int k = 0; k < count; k++) {
         const real *A = seg + RHOD_SEG_STRIDE * (first + k);
         const real *B = seg + RHOD_SEG_STRIDE * (first + (k + 1) % count);
-        if ((A[1] > yi) != (B[1] > yi) && xi < A[0] + (yi - A[1]) * (B[0] - A[0]) / (B[1] - A[1]))
+        if (RHOD_RAY_CROSSES(A[0], A[1], B[0], B[1], xi, yi))
           in = !in;
       }
     }

@@ -7,6 +7,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "scene_bodies.h"
+#include "rhod/boundary.h"
 
 #include <math.h>
 #include <matheval.h>
@@ -169,8 +170,7 @@ static int outline_holds(const outline *o, const double *q) {
     const double *P = o->p[a], *Q = o->p[b];
     if (seg_dist(q, P, Q) == 0)
       return 1;
-    if ((P[1] > q[1]) != (Q[1] > q[1]) &&
-        q[0] < (Q[0] - P[0]) * (q[1] - P[1]) / (Q[1] - P[1]) + P[0])
+    if (RHOD_RAY_CROSSES(P[0], P[1], Q[0], Q[1], q[0], q[1]))
       in = !in;
   }
   return in;

@@ -24,7 +24,7 @@ static int in_shape(const rhod_shape *sh, double x, double y) {
   int inside = 0; /* even-odd rule */
   for (unsigned a = 0, b = sh->n_points - 1; a < sh->n_points; b = a++) {
     const double *P = sh->points[a], *Q = sh->points[b];
-    if ((P[1] > y) != (Q[1] > y) && x < (Q[0] - P[0]) * (y - P[1]) / (Q[1] - P[1]) + P[0])
+    if (RHOD_RAY_CROSSES(P[0], P[1], Q[0], Q[1], x, y))
       inside = !inside;
   }
   return inside;

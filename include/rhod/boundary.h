@@ -101,6 +101,14 @@ long rhod_walls_guard(const rhod_boundary *b, rhod_particles *p);
  * wall guard puts back), or -1; *body its body's index. Host-side result of a device loop. */
 long rhod_bodies_entered(const rhod_boundary *b, const rhod_particles *p, int *body);
 
+/* Whether the ray from (x, y) along +x crosses the edge from (ax, ay) to (bx, by): the
+ * step of the crossing-number (even-odd) test that every inside-a-polygon question here
+ * uses (scene shapes, held regions, bodies' outlines). A macro, so that it serves the host's
+ * doubles and the device's reals alike; each argument is read once or twice, so pass plain
+ * values. */
+#define RHOD_RAY_CROSSES(ax, ay, bx, by, x, y)                                                     \
+  (((ay) > (y)) != ((by) > (y)) && (x) < (ax) + ((y) - (ay)) * ((bx) - (ax)) / ((by) - (ay)))
+
 /* A point moved off the walls (pass walls and bodies, not the open boundaries' segments: a
  * test of a segment's kind here made GCC 12's nvptx compiler fail, tree-nrv.cc:179): where
  * (x, y) lies less than `keep` in front of a wall (or behind it, by less than `back`), with its

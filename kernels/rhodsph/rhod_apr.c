@@ -89,7 +89,7 @@ static inline real held_dx(int nh, const real *hr, const real *hp, real x, real 
         const real u = l2 > 0 ? fmin(fmax((wx * ex + wy * ey) / l2, 0), 1) : 0;
         const real dx_ = wx - u * ex, dy_ = wy - u * ey;
         d2 = fmin(d2, dx_ * dx_ + dy_ * dy_);
-        if ((A[1] > y) != (B[1] > y) && x < A[0] + (y - A[1]) / (B[1] - A[1]) * ex)
+        if (RHOD_RAY_CROSSES(A[0], A[1], B[0], B[1], x, y))
           in = !in;
       }
       d = in ? -sqrt(d2) : sqrt(d2);
