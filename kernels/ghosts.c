@@ -36,11 +36,14 @@ static inline real seg_dist2(const real *S, real x, real y) {
  * as its source passes a vertex's bisector instead of appearing whole. A point outside the
  * outline (the image of fluid across a thin body or an acute keel) gets 0. Where only face
  * k reaches q the share is m/m = 1 exactly: a face away from vertices keeps the source's
- * mass bit for bit. Walls are not asked: a wall with the fluid outside next to an open
- * boundary would count faces whose preimage lies beyond it, where there is no fluid
- * (test_open's channel lost its exact outflow balance), so its mirrors stay whole. */
-static inline real face_share(const real *seg, int k, int first, int count, real qx, real qy,
-                              real R) {
+ * mass bit for bit. A face f whose preimage of q (q + 2 e_f n_f) lies where no fluid can
+ * stand, outside the domain box [xlo, xhi] x [ylo, yhi] (a periodic axis: unbounded) or
+ * behind the line of an open boundary (segments [o0, o1)), takes no share (face k itself
+ * always does: its preimage is the source, which may have crossed an outflow's line before
+ * its deletion): no image of f reaches q (an obstacle wall thinner than 2 R at the domain's edge,
+ * or one that runs past an outflow: its far face, its end face). */
+static inline real face_share(const real *seg, int k, int first, int count, int o0, int o1,
+                              real xlo, real xhi, real ylo, real yhi, real qx, real qy, real R) {
   /* the two nearest faces' squared distances (a face R or more away caps no margin) */
   real d1 = R * R, d2 = R * R;
   int i1 = -1, inside = 0;
@@ -64,6 +67,14 @@ static inline real face_share(const real *seg, int k, int first, int count, real
     const real rx = qx - S[0], ry = qy - S[1];
     const real e = -(S[2] * rx + S[3] * ry), t = S[4] * rx + S[5] * ry;
     if (!(e > 0 && e < R && t >= 0 && t <= S[6]))
+      continue;
+    const real px = qx + 2 * e * S[2], py = qy + 2 * e * S[3]; /* the preimage */
+    int beyond = px < xlo || px > xhi || py < ylo || py > yhi;
+    for (int o = o0; o < o1; o++) {
+      const real *O = seg + RHOD_SEG_STRIDE * o;
+      beyond |= O[2] * (px - O[0]) + O[3] * (py - O[1]) < 0;
+    }
+    if (beyond && s != k) /* k's preimage is the source itself, wherever it stands */
       continue;
     real m = R - e;
     m = t < m ? t : m;
@@ -186,7 +197,8 @@ static inline void corner_map(const real *A_, const real *B_, const real *openu,
  * per-warp nvptx frame, shared by the 32 lanes of a simd loop, and the lanes would
  * overwrite each other's mirrors (tools/check_offload_frames.sh guards against any such
  * array in a kernel). */
-static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner, int ncorner,
+static inline int wall_mirrors(const real *seg, int nseg, int o0, int o1, real xlo, real xhi,
+                               real ylo, real yhi, const int32_t *corner, int ncorner,
                                const real *circ, int ncirc, const real *kin, const real *openu,
                                real x, real y, real R, real ms, real *gx, real *gy, real *J,
                                real *T, real *U, real *Tv, real *Uv, real *A, int32_t *B, real *M) {
@@ -201,9 +213,11 @@ static inline int wall_mirrors(const real *seg, int nseg, const int32_t *corner,
     const real qx = x - 2 * d * S[2], qy = y - 2 * d * S[3];
     const int body = (int)S[10];
     /* our choice (docs/choices.md "bodies: ghosts near convex vertices"): the faces of a
-     * body share its inside near a convex vertex, so that their images neither overlap nor
-     * appear whole when a source crosses the vertex's bisector */
-    const real share = S[14] != 0 ? face_share(seg, s, (int)S[11], (int)S[12], qx, qy, R) : (real)1;
+     * body or an obstacle wall share its inside near a convex vertex, so that their images
+     * neither overlap nor appear whole when a source crosses the vertex's bisector */
+    const real share = S[14] != 0 ? face_share(seg, s, (int)S[11], (int)S[12], o0, o1, xlo, xhi,
+                                               ylo, yhi, qx, qy, R)
+                                  : (real)1;
     if (!(share > 0))
       continue;
     if (gx) {
@@ -412,9 +426,15 @@ void rhod_walls_near(const rhod_boundary *b, const rhod_particles *p, real ratio
 
 /* Phase 1: wall mirrors of the fluid. Returns the number of ghosts written or < 0. */
 static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
-  const int nseg = b->nseg, ncorner = b->ncorner, ncirc = b->ncirc;
+  const int nseg = b->nseg, ncorner = b->ncorner, ncirc = b->ncirc, o0 = b->open0;
+  const int o1 = b->nwallseg;
   if (nseg + ncirc == 0)
     return 0;
+  /* where fluid can stand (face_share): the domain box, unbounded along a periodic axis */
+  const real xlo = b->periodic[0] ? (real)-1e30 : (real)b->lo[0];
+  const real xhi = b->periodic[0] ? (real)1e30 : (real)b->hi[0];
+  const real ylo = b->periodic[1] ? (real)-1e30 : (real)b->lo[1];
+  const real yhi = b->periodic[1] ? (real)1e30 : (real)b->hi[1];
   const long n = (long)p->n;
   if (ensure_count(b, p->n + 1) != RHOD_OK)
     return -1;
@@ -429,9 +449,9 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
         cnt[i] = 0;
         continue;
       }
-      cnt[i] = wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, openu, x[i], y[i],
-                            ratio * dx[i], 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
-                            NULL);
+      cnt[i] = wall_mirrors(seg, nseg, o0, o1, xlo, xhi, ylo, yhi, corner, ncorner, circ, ncirc,
+                            kin, openu, x[i], y[i], ratio * dx[i], 0, NULL, NULL, NULL, NULL, NULL,
+                            NULL, NULL, NULL, NULL, NULL);
     }
     const long total = rhod_scan_exclusive(cnt, (size_t)n + 1);
     if (total < 0)
@@ -450,10 +470,11 @@ static long build_wall_ghosts(rhod_boundary *b, rhod_particles *p, real ratio) {
       if (c == 0)
         continue;
       const long base = n + cnt[i];
-      wall_mirrors(seg, nseg, corner, ncorner, circ, ncirc, kin, openu, gxo[i], gyo[i],
-                   ratio * gdx[i], m[i], gxo + base, gyo + base, gJ + 4 * base, gT + 4 * base,
-                   gU + 2 * base, gTv ? gTv + 4 * base : NULL, gTv ? gUv + 2 * base : NULL,
-                   gA ? gA + 2 * base : NULL, gbody ? gbody + base : NULL, m + base);
+      wall_mirrors(seg, nseg, o0, o1, xlo, xhi, ylo, yhi, corner, ncorner, circ, ncirc, kin, openu,
+                   gxo[i], gyo[i], ratio * gdx[i], m[i], gxo + base, gyo + base, gJ + 4 * base,
+                   gT + 4 * base, gU + 2 * base, gTv ? gTv + 4 * base : NULL,
+                   gTv ? gUv + 2 * base : NULL, gA ? gA + 2 * base : NULL,
+                   gbody ? gbody + base : NULL, m + base);
       for (long g = base; g < base + c; g++) {
         gdx[g] = gdx[i];
         gsrc[g] = (int32_t)i;

@@ -41,7 +41,9 @@ static int push_polygon(real **seg, int *nseg, int32_t **corner, int *ncorner,
     S[9] = moves ? (real)vel[1] : 0;
     S[10] = (real)body;
     S[13] = (real)refine;
-    S[14] = body >= 0; /* shares at convex vertices: bodies only (ghosts.c face_share) */
+    /* shares at convex vertices (ghosts.c face_share): bodies and obstacle walls, the
+     * outlines with the fluid outside */
+    S[14] = body >= 0 || !fluid_inside;
     (*nseg)++;
   }
   /* corners: edge k ends where edge k+1 starts; the fluid wedge there is narrower

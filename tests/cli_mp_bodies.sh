@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# The multiphase scheme beside bodies at rest (tests/scenes/run/mp_bodies_rest.yaml): the
-# run reaches its end and its last snapshot has every particle outside both bodies (the
-# distance to the nearer is printed).
+# The multiphase scheme beside bodies at rest (tests/scenes/run/mp_bodies_rest.yaml), and
+# beside the same square as an obstacle wall (mp_wall_obstacle_rest.yaml: the binary before
+# its faces shared the inside stops at step 68): each run reaches its end and its last
+# snapshot has every particle outside the bodies and the square (the distance to the nearer
+# is printed).
 set -uo pipefail
 RHOD=$1; SRC=$2
 # shellcheck source=lib_cli.sh
@@ -27,5 +29,22 @@ dcy = np.hypot(x - 0.7, y - 0.4) - 0.1
 near = min(dsq.min(), dcy.min()) / 0.02
 print(f"  {len(x)} particles; nearest to a body {near:.3f} dx")
 sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from a body")
+PY
+expect 0 "multiphase run beside an obstacle wall at rest" -- \
+  "$RHOD" run "$SRC/tests/scenes/run/mp_wall_obstacle_rest.yaml" -o "$T/wall"
+check "every particle outside the obstacle wall" -- /usr/bin/python3 - "$T/wall" "$SRC" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[2] + "/tools")
+import numpy as np
+import rhodout
+d = rhodout.read_snapshot(rhodout.snapshots(sys.argv[1])[-1])
+x, y = d["pos"][:, 0], d["pos"][:, 1]
+ins = (x > 0.15) & (x < 0.35) & (y > 0.54) & (y < 0.74)
+depth = np.minimum(np.minimum(x - 0.15, 0.35 - x), np.minimum(y - 0.54, 0.74 - y))
+out = np.hypot(np.maximum(np.maximum(0.15 - x, x - 0.35), 0),
+               np.maximum(np.maximum(0.54 - y, y - 0.74), 0))
+near = np.where(ins, -depth, out).min() / 0.02
+print(f"  {len(x)} particles; nearest to the square {near:.3f} dx")
+sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from the square")
 PY
 summary mp_bodies

@@ -18,8 +18,8 @@
   15 /* ax, ay, nx, ny, tx, ty, length, kind (RHOD_SEG_*), ux, uy (a wall edge's velocity along    \
         itself, walls.N.velocity; 0 at rest), body (its index, -1 for a wall or an open            \
         boundary), first, count (the outline's segments; an open boundary's markers), refine (1:   \
-        refinement criterion 4 near it), share (1: a body's face, whose mirrors share the body's   \
-        inside near a convex vertex: ghosts.c face_share) */
+        refinement criterion 4 near it), share (1: a body's or an obstacle wall's face, whose      \
+        mirrors share its inside near a convex vertex: ghosts.c face_share) */
 /* S[7], what a segment is: a wall or body with free or no slip, or an open boundary
  * (open.h) whose mirrors carry the inflow's velocity (T = 0, U = the marker's) or the
  * fluid's (an outflow: T = I, U = 0) */
