@@ -8,9 +8,9 @@ set -uo pipefail
 RHOD=$1; SRC=$2
 # shellcheck source=lib_cli.sh
 source "$(dirname "$0")/lib_cli.sh"
-expect 0 "multiphase run beside two bodies at rest" -- \
-  "$RHOD" run "$SRC/tests/scenes/run/mp_bodies_rest.yaml" -o "$T/run"
-check "every particle outside the bodies" -- /usr/bin/python3 - "$T/run" "$SRC" <<'PY'
+# the nearest distance (in dx) of the last snapshot's particles to the square and, with
+# "circle", the circle; exits non-zero when a particle is inside
+NEAREST=$(cat <<'PY'
 import sys
 sys.path.insert(0, sys.argv[2] + "/tools")
 import numpy as np
@@ -24,27 +24,18 @@ def square(x0, y0, x1, y1):
     ins = (x > x0) & (x < x1) & (y > y0) & (y < y1)
     depth = np.minimum(np.minimum(x - x0, x1 - x), np.minimum(y - y0, y1 - y))
     return np.where(ins, -depth, np.hypot(ox, oy))
-dsq = square(0.15, 0.54, 0.35, 0.74)
-dcy = np.hypot(x - 0.7, y - 0.4) - 0.1
-near = min(dsq.min(), dcy.min()) / 0.02
-print(f"  {len(x)} particles; nearest to a body {near:.3f} dx")
-sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from a body")
+near = square(0.15, 0.54, 0.35, 0.74).min()
+if sys.argv[3] == "circle":
+    near = min(near, (np.hypot(x - 0.7, y - 0.4) - 0.1).min())
+near /= 0.02
+print(f"  {len(x)} particles; nearest to a solid {near:.3f} dx")
+sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from a solid")
 PY
+)
+expect 0 "multiphase run beside two bodies at rest" -- \
+  "$RHOD" run "$SRC/tests/scenes/run/mp_bodies_rest.yaml" -o "$T/run"
+check "every particle outside the bodies" -- /usr/bin/python3 -c "$NEAREST" "$T/run" "$SRC" circle
 expect 0 "multiphase run beside an obstacle wall at rest" -- \
   "$RHOD" run "$SRC/tests/scenes/run/mp_wall_obstacle_rest.yaml" -o "$T/wall"
-check "every particle outside the obstacle wall" -- /usr/bin/python3 - "$T/wall" "$SRC" <<'PY'
-import sys
-sys.path.insert(0, sys.argv[2] + "/tools")
-import numpy as np
-import rhodout
-d = rhodout.read_snapshot(rhodout.snapshots(sys.argv[1])[-1])
-x, y = d["pos"][:, 0], d["pos"][:, 1]
-ins = (x > 0.15) & (x < 0.35) & (y > 0.54) & (y < 0.74)
-depth = np.minimum(np.minimum(x - 0.15, 0.35 - x), np.minimum(y - 0.54, 0.74 - y))
-out = np.hypot(np.maximum(np.maximum(0.15 - x, x - 0.35), 0),
-               np.maximum(np.maximum(0.54 - y, y - 0.74), 0))
-near = np.where(ins, -depth, out).min() / 0.02
-print(f"  {len(x)} particles; nearest to the square {near:.3f} dx")
-sys.exit(0 if near > 0 else f"a particle {near:.3f} dx from the square")
-PY
+check "every particle outside the obstacle wall" -- /usr/bin/python3 -c "$NEAREST" "$T/wall" "$SRC" square
 summary mp_bodies
