@@ -61,8 +61,12 @@ static inline real face_share(const real *seg, int k, int first, int count, int 
   }
   if (!inside)
     return 0;
+  /* with face k alone within R (away from the vertices: most mirrors) no other face can
+   * reach q, and the loop below needs only k: mk / sum = 1 (0 at k's very ends) */
+  const int lone = !(d2 < R * R);
+  const int s0 = lone ? k : first, s1 = lone ? k + 1 : first + count;
   real mk = 0, sum = 0;
-  for (int s = first; s < first + count; s++) {
+  for (int s = s0; s < s1; s++) {
     const real *S = seg + RHOD_SEG_STRIDE * s;
     const real rx = qx - S[0], ry = qy - S[1];
     const real e = -(S[2] * rx + S[3] * ry), t = S[4] * rx + S[5] * ry;
